@@ -1,0 +1,124 @@
+"""Tracking quality against ground truth: limb directions, joint positions, local rotations.
+
+Limb-direction error: the angle between tracked and true world directions of a bone (its
+joint to its child joint or end site) -- axial twist, which no camera sees well, does not
+enter it. Joint-position error: distance between tracked and true joint positions after
+both are taken relative to their root, in millimetres for a skeleton in metres.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from core import se3
+from core.bvh import BvhFile
+from core.skeleton import HINGE, Skeleton
+
+# (label, from, to): a joint name, or "<joint>/end" for that joint's first end site
+LIMBS = [
+    ("left thigh", "LeftHip", "LeftKnee"), ("right thigh", "RightHip", "RightKnee"),
+    ("left shank", "LeftKnee", "LeftAnkle"), ("right shank", "RightKnee", "RightAnkle"),
+    ("left upper arm", "LeftShoulder", "LeftElbow"),
+    ("right upper arm", "RightShoulder", "RightElbow"),
+    ("left forearm", "LeftElbow", "LeftWrist"), ("right forearm", "RightElbow", "RightWrist"),
+    ("neck-head", "Neck", "Head/end"),
+]
+HEADLINE = [label for label, _, _ in LIMBS[:8]]  # the eight limb bones
+
+
+def world_points(sk: Skeleton, rotations: np.ndarray, roots: np.ndarray) -> np.ndarray:
+    """World joint positions (F, J, 3) for rotations (F, J, 3, 3) and root positions (F, 3)."""
+    return np.array([sk.world_positions(R, p) for R, p in zip(rotations, roots)])
+
+
+def _point(sk: Skeleton, frames: np.ndarray, name: str) -> np.ndarray:
+    """World position of a joint, or of "<joint>/end", its first end site, given its frames."""
+    joint, _, end = name.partition("/")
+    M = frames[sk.index(joint)]
+    return M[:3, :3] @ sk.end_sites[sk.index(joint)][0] + M[:3, 3] if end else M[:3, 3]
+
+
+def limb_vectors(sk: Skeleton, rotations, roots) -> dict[str, np.ndarray]:
+    """World direction vectors (F, 3) of each limb."""
+    frames = [sk.joint_frames(R, p) for R, p in zip(rotations, roots)]
+    return {label: np.array([_point(sk, M, b) - _point(sk, M, a) for M in frames])
+            for label, a, b in LIMBS}
+
+
+@dataclass
+class Scores:
+    limb_deg: dict[str, float]  # mean over frames, per limb
+    limb_mean_deg: float  # mean over the eight limb bones
+    position_mm: float  # mean root-relative joint-position error
+    local_deg: dict[str, float]  # mean local-rotation error per tracked joint
+    per_frame_limb_deg: np.ndarray  # (F,) mean over the eight limbs
+
+
+def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
+          unit_mm: float = 1000.0) -> Scores:
+    """Compare (rotations, roots) of an estimate with the truth over the same frames."""
+    F = min(len(est[0]), len(truth[0]))
+    est = (est[0][:F], est[1][:F])
+    truth = (truth[0][:F], truth[1][:F])
+    ve, vt = limb_vectors(sk, *est), limb_vectors(sk, *truth)
+    per = {k: np.degrees(se3.angle_between_vectors(ve[k], vt[k])) for k in ve}
+    pe, pt = world_points(sk, *est), world_points(sk, *truth)
+    rel = (pe - pe[:, :1]) - (pt - pt[:, :1])
+    local = {}
+    for n in tracked_joints:
+        j = sk.index(n)
+        local[n] = float(np.degrees(se3.rotation_angle_between(est[0][:, j], truth[0][:, j])).mean())
+    per_frame = np.mean([per[k] for k in HEADLINE], axis=0)
+    return Scores({k: float(v.mean()) for k, v in per.items()}, float(per_frame.mean()),
+                  float(np.linalg.norm(rel, axis=-1).mean() * unit_mm), local, per_frame)
+
+
+def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:
+    return bvh.poses()
+
+
+def held_still(truth: tuple) -> tuple:
+    """The first frame's pose repeated over every frame, root included."""
+    R, p = truth
+    return np.repeat(R[:1], len(R), 0), np.repeat(p[:1], len(p), 0)
+
+
+def best_fit(sk: Skeleton, truth: tuple) -> tuple:
+    """The pose with the skeleton's tracked degrees of freedom (and a free root) that best fits
+    the true 3-D joint positions, frame by frame; untracked joints keep the first frame's
+    rotation, hinges turn about their axis from the first frame's rotation."""
+    R_true, p_true = truth
+    dof_joint, dof_axis = sk.dof_joints_and_axes()
+    base = R_true[0].copy()
+    target = world_points(sk, R_true, p_true)
+
+    def pose_of(x):
+        R = base.copy()
+        R[0] = se3.exp_so3(x[3:6]) @ base[0]
+        k = 6
+        for j in sorted(set(dof_joint.tolist())):
+            if sk.kinds[j] == HINGE:
+                R[j] = base[j] @ se3.exp_so3(dof_axis[k - 6] * x[k])
+                k += 1
+            else:
+                R[j] = base[j] @ se3.exp_so3(x[k:k + 3])
+                k += 3
+        return R, x[:3]
+
+    # parameters per DOF in the skeleton's order, which groups each joint's DOFs together
+    n = 6 + len(dof_joint)
+    x = np.zeros(n)
+    x[:3] = p_true[0]
+    out_R, out_p = [], []
+    for f in range(len(R_true)):
+        def resid(x, f=f):
+            R, p = pose_of(x)
+            return (sk.world_positions(R, p) - target[f]).ravel()
+        x = least_squares(resid, x, method="lm").x
+        R, p = pose_of(x)
+        out_R.append(R)
+        out_p.append(p)
+    return np.array(out_R), np.array(out_p)

@@ -1,0 +1,171 @@
+"""The tracking benchmark: rendered CMU walk, three Muybridge-style views, tracked through the
+command line, scored against the capture.
+
+    python bench/walk_benchmark.py [--cache .cache/walk] [--runs NAME,...]
+
+Renders the footage once (bench/walk_footage.py, cached), writes one job per run, runs
+``python -m core track`` on each, and prints tables of limb-direction error, joint-position
+error, local-rotation error, frames tracked before any divergence and speed, beside two
+references on the same frames: the first frame held still, and the best fit that the tracked
+degrees of freedom allow to the true 3-D joints.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import evaluate  # noqa: E402
+from walk_footage import render  # noqa: E402
+
+from core.bvh import read_bvh  # noqa: E402
+from core.job import load_job  # noqa: E402
+
+# The paper's 19 degrees of freedom on the CMU skeleton: ball hips, shoulders and neck; knees
+# and elbows as hinges about the capture's own flexion axes (local frame).
+JOINTS = {
+    "LeftHip": "ball", "RightHip": "ball", "LeftShoulder": "ball", "RightShoulder": "ball",
+    "Neck": "ball",
+    "LeftKnee": {"kind": "hinge", "axis": [0.94, 0.34, 0.0]},
+    "RightKnee": {"kind": "hinge", "axis": [0.94, -0.34, 0.0]},
+    "LeftElbow": {"kind": "hinge", "axis": [0.87, 0.0, -0.5]},
+    "RightElbow": {"kind": "hinge", "axis": [0.87, 0.0, 0.5]},
+}
+# blob short radii a user would set to line the blobs up with this body (metres)
+BLOBS = {
+    "LHipJoint": {"radius": 0.1}, "RHipJoint": {"radius": 0.1},
+    "lowerback": {"radii": [0.12, 0.09]}, "Chest": {"radii": [0.13, 0.09]},
+    "LeftHip": {"radius": 0.075}, "RightHip": {"radius": 0.075},
+    "LeftKnee": {"radius": 0.05}, "RightKnee": {"radius": 0.05},
+    "LeftAnkle": {"radius": 0.04}, "RightAnkle": {"radius": 0.04},
+    "LeftShoulder": {"radius": 0.045}, "RightShoulder": {"radius": 0.045},
+    "LeftElbow": {"radius": 0.037}, "RightElbow": {"radius": 0.037},
+    "Neck": {"radius": 0.05}, "Head": {"radius": 0.085},
+    "LeftCollar": {"radius": 0.06}, "RightCollar": {"radius": 0.06},
+    "LeftToe": False, "RightToe": False, "LeftWrist": False, "RightWrist": False,
+}
+# name: (views, mode, capture frames per video frame: 4 = 30 fps, 8 = 15 fps)
+RUNS = {
+    "3 views calibrated 15 fps": (["lateral", "endon", "oblique60"], "calibrated", 8),
+    "1 lateral view 15 fps": (["lateral"], "calibrated", 8),
+    "3 views independent 15 fps": (["lateral", "endon", "oblique60"], "independent", 8),
+    "3 views calibrated 30 fps": (["lateral", "endon", "oblique60"], "calibrated", 4),
+    "1 lateral view 30 fps": (["lateral"], "calibrated", 4),
+}
+CAPTURE_FPS = 120
+
+
+def write_job(cache: Path, name: str, views, mode: str, step: int, frames: list[int],
+              cameras: dict, settings: dict) -> Path:
+    keep = frames[:: step // 4]
+    jobs = cache / "jobs"
+    jobs.mkdir(exist_ok=True)
+    job = {
+        "skeleton": {"bvh": "../truth.bvh", "joints": JOINTS, "blobs": BLOBS},
+        "initial": {"bvh": "../truth.bvh", "frame": 0},
+        "views": [{"images": [f"../{v}/{f:04d}.png" for f in keep], "camera": cameras[v]}
+                  for v in views],
+        "mode": mode,
+        "settings": settings,
+        "frame_time": step / CAPTURE_FPS,
+    }
+    path = jobs / (name.replace(" ", "_") + ".json")
+    path.write_text(json.dumps(job, indent=1))
+    return path
+
+
+def fmt(x, digits=1):
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
+    ap.add_argument("--first", type=int, default=300)
+    ap.add_argument("--last", type=int, default=772)
+    ap.add_argument("--runs", default=",".join(RUNS), help="comma-separated run names")
+    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
+    a = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    info = render(a.cache, a.first, a.last, 4, ["lateral", "endon", "oblique60"])
+    print(f"footage: {len(info['frames'])} frames x 3 views at 30 fps in {a.cache}"
+          f" ({info['rendered']} rendered, {time.perf_counter() - t0:.0f} s)", flush=True)
+    truth_bvh = read_bvh(a.cache / "truth.bvh")
+    truth_all = truth_bvh.poses()
+    settings = json.loads(a.settings)
+
+    results, refs = {}, {}
+    for name in a.runs.split(","):
+        views, mode, step = RUNS[name]
+        job_path = write_job(a.cache, name, views, mode, step, info["frames"], info["cameras"],
+                             settings)
+        out = job_path.with_suffix(".bvh")
+        rep_path = job_path.with_suffix(".report.json")
+        cmd = [sys.executable, "-m", "core", "track", str(job_path), "--out", str(out),
+               "--report", str(rep_path), "--quiet"]
+        proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        if proc.returncode not in (0, 3):
+            print(proc.stderr)
+            raise SystemExit(f"{name}: the tracker failed (exit {proc.returncode})")
+        rep = json.loads(rep_path.read_text())
+        job = load_job(job_path)
+        sk = job.skeleton
+        tracked_names = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+        sel = slice(None, None, step // 4)
+        truth = (truth_all[0][sel], truth_all[1][sel])
+        est = read_bvh(out).poses()
+        results[name] = (evaluate.score(sk, tracked_names, est, truth), rep)
+        if step not in refs:
+            refs[step] = (
+                evaluate.score(sk, tracked_names, evaluate.held_still(truth), truth),
+                evaluate.score(sk, tracked_names, evaluate.best_fit(sk, truth), truth),
+            )
+        s = results[name][0]
+        print(f"{name}: limb {s.limb_mean_deg:.1f} deg, {rep['frames_tracked']}/"
+              f"{rep['frames_total']} frames, {rep['frames_per_second']:.1f} fps", flush=True)
+
+    print()
+    print("| run | frames tracked | limb dir. err (8 limbs) | neck-head | joint pos. err |"
+          " held still | best fit | tracking fps | s / iteration |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name, (s, rep) in results.items():
+        still, best = refs[RUNS[name][2]]
+        first_div = rep["diverged_frames"][0] if rep["diverged_frames"] else None
+        tracked = f"{rep['frames_tracked']}/{rep['frames_total']}" + (
+            f" (diverged at {first_div})" if first_div is not None else "")
+        print(f"| {name} | {tracked} | {s.limb_mean_deg:.1f}° | {s.limb_deg['neck-head']:.1f}° |"
+              f" {s.position_mm:.0f} mm | {still.limb_mean_deg:.1f}° | {best.limb_mean_deg:.1f}° |"
+              f" {fmt(rep['frames_per_second'])} | {fmt(rep['seconds_per_iteration'], 3)} |")
+    print()
+    names = list(results)
+    print("| limb direction (°) | " + " | ".join(names) + " | held still (15 fps) |"
+          " best fit (15 fps) |")
+    print("|---" * (len(names) + 3) + "|")
+    ref15 = refs.get(8) or next(iter(refs.values()))
+    for limb in results[names[0]][0].limb_deg:
+        cells = [f"{results[n][0].limb_deg[limb]:.1f}" for n in names]
+        print(f"| {limb} | " + " | ".join(cells) + f" | {ref15[0].limb_deg[limb]:.1f} |"
+              f" {ref15[1].limb_deg[limb]:.1f} |")
+    print()
+    print("| local rotation (°, for information) | " + " | ".join(names) + " | best fit |")
+    print("|---" * (len(names) + 2) + "|")
+    for joint in results[names[0]][0].local_deg:
+        cells = [f"{results[n][0].local_deg[joint]:.1f}" for n in names]
+        print(f"| {joint} | " + " | ".join(cells) + f" | {ref15[1].local_deg[joint]:.1f} |")
+    print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; 480x360 footage, "
+          f"{len(JOINTS)} tracked joints (19 degrees of freedom)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

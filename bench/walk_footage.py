@@ -1,0 +1,275 @@
+"""Render Muybridge-style footage of the CMU walk with Blender, and write tracking jobs for it.
+
+The body is *not* the tracker's model: tapered elliptical capsules over the capture's bones,
+skinned to the armature with weights that blend each bone into its parent at the joint, coloured with a
+cloth-like pattern, lit by Workbench's studio light, with sensor noise added. Three orthographic
+views at 480x360 (lateral, end-on at 90 degrees, oblique at 60 degrees) see a fixed stage.
+
+Blender's world is the BVH's world (imported without axis change: y up, metres), so the job's
+cameras and the ground truth need no conversion. Run with the project's virtual environment:
+
+    python bench/walk_footage.py --out .cache/walk --first 300 --last 772 --step 4
+
+Writes OUT/<view>/NNNN.png, OUT/truth.bvh (the capture's frames that were rendered, the
+ground truth) and OUT/cameras.json. Frames already rendered with the same settings are kept.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from core.bvh import read_bvh, write_bvh  # noqa: E402
+from core.skeleton import skeleton_from_bvh  # noqa: E402
+
+CMU_WALK = ROOT.parent / "shared" / "data" / "mocap" / "cmu_131_01_walk.bvh"
+WIDTH, HEIGHT = 480, 360
+PIXELS_PER_METRE = 150.0
+STAGE_CENTRE = np.array([0.5, 0.85, -0.55])  # world point at the middle of every image
+NOISE_SIGMA = 2.0  # sensor noise, grey levels of 255
+
+# body radii (metres, across and front to back) by CMU joint name; unnamed joints get DEFAULT_RADIUS
+RADII = {
+    "Hips": (0.12, 0.10), "LHipJoint": (0.11, 0.09), "RHipJoint": (0.11, 0.09),
+    "LeftHip": (0.085, 0.085), "RightHip": (0.085, 0.085),
+    "LeftKnee": (0.055, 0.055), "RightKnee": (0.055, 0.055),
+    "LeftAnkle": (0.045, 0.045), "RightAnkle": (0.045, 0.045),
+    "LeftToe": (0.035, 0.03), "RightToe": (0.035, 0.03),
+    "lowerback": (0.11, 0.09), "Chest": (0.12, 0.09), "Chest2": (0.12, 0.09),
+    "lowerneck": (0.06, 0.06), "Neck": (0.05, 0.05), "Head": (0.085, 0.09),
+    "LeftCollar": (0.07, 0.06), "RightCollar": (0.07, 0.06),
+    "LeftShoulder": (0.045, 0.045), "RightShoulder": (0.045, 0.045),
+    "LeftElbow": (0.04, 0.04), "RightElbow": (0.04, 0.04),
+    "LeftWrist": (0.032, 0.032), "RightWrist": (0.032, 0.032),
+}
+DEFAULT_RADIUS = (0.03, 0.03)
+SKIPPED = ("Fingers", "Thumb", "hand")  # small parts left out of the body
+
+
+def camera_rotations() -> dict[str, np.ndarray]:
+    """World-to-camera rotations (rows: image x right, image y down, viewing direction)."""
+    up = np.array([0.0, 1.0, 0.0])
+
+    def look(direction):
+        z = direction / np.linalg.norm(direction)
+        y = -up
+        x = np.cross(y, z)
+        return np.stack([x, y, z])
+
+    a = np.radians(60)
+    return {
+        "lateral": look(np.array([1.0, 0, 0])),  # walker moves left to right
+        "endon": look(np.array([0, 0, -1.0])),  # the walker comes toward the camera
+        "oblique60": look(np.array([np.cos(a), 0, -np.sin(a)])),
+    }
+
+
+def job_camera(R: np.ndarray) -> dict:
+    """The job's camera dict: pixel = s (R X + t)[:2] + center, with STAGE_CENTRE mid-image."""
+    return {
+        "model": "scaled_orthographic",
+        "R": R.tolist(),
+        "t": (-R @ STAGE_CENTRE).tolist(),
+        "scale": PIXELS_PER_METRE,
+        "center": [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5],
+    }
+
+
+def cloth_colour(P: np.ndarray, seed: int = 7) -> np.ndarray:
+    """A woven, blotchy pattern of rest-pose positions (N, 3) -> RGB in [0, 1] (N, 3)."""
+    rng = np.random.default_rng(seed)
+    stripes = 0.5 + 0.5 * np.sign(np.sin(P[:, 1] * 2 * np.pi / 0.07)) * np.sign(
+        np.sin((P[:, 0] + P[:, 2]) * 2 * np.pi / 0.09))
+    k = rng.normal(size=(10, 3))
+    k *= 2 * np.pi / 0.05 / np.linalg.norm(k, axis=1, keepdims=True) * rng.uniform(0.6, 1.6, (10, 1))
+    blotch = np.sin(P @ k.T + rng.uniform(0, 6.3, 10)).mean(1)
+    base = np.array([0.45, 0.28, 0.2]) + 0.4 * stripes[:, None] * np.array([0.6, 0.9, 1.0])
+    return np.clip(base + 0.6 * blotch[:, None], 0.02, 0.98)
+
+
+def _capsule_body(sk, spacing: float = 0.01, around: int = 32):
+    """A body of tapered elliptical capsules, one per bone (joint to child or end site).
+
+    Returns vertices (N, 3) in the rest pose, quad faces (M, 4) and, per vertex, its joint and
+    weight and its parent joint and weight (blended over the first fifth of the bone, so that
+    joints bend smoothly)."""
+    verts, faces, groups = [], [], []
+    for j, name in enumerate(sk.names):
+        if any(x in name for x in SKIPPED):
+            continue
+        a = sk.rest_positions[j]
+        tips = [(sk.rest_positions[c], sk.names[c]) for c in sk.children(j)
+                if not any(x in sk.names[c] for x in SKIPPED)]
+        tips += [(a + e, None) for e in sk.end_sites[j]]
+        ra = np.array(RADII.get(name, DEFAULT_RADIUS))
+        for tip, tip_name in tips:
+            L = float(np.linalg.norm(tip - a))
+            if L < 1e-4:
+                continue
+            rb = np.array(RADII.get(tip_name, 0.8 * ra)) if tip_name else 0.8 * ra
+            u = (tip - a) / L
+            v = np.array([1.0, 0, 0]) - u[0] * u
+            if np.linalg.norm(v) < 0.3:
+                v = np.array([0, 0, 1.0]) - u[2] * u
+            v /= np.linalg.norm(v)
+            w = np.cross(u, v)
+            rings = []  # (axial position, radius scale, taper parameter)
+            for th in np.linspace(-80, 0, 6, endpoint=False):
+                rings.append((ra.mean() * np.sin(np.radians(th)), np.cos(np.radians(th)), 0.0))
+            for t in np.linspace(0, 1, max(int(L / spacing), 2)):
+                rings.append((t * L, 1.0, t))
+            for th in np.linspace(0, 80, 6)[1:]:
+                rings.append((L + rb.mean() * np.sin(np.radians(th)), np.cos(np.radians(th)), 1.0))
+            phi = np.linspace(0, 2 * np.pi, around, endpoint=False)
+            base = len(verts)
+            parent = int(sk.parents[j])
+            for s_ax, c, t in rings:
+                r = (1 - t) * ra + t * rb
+                ring = (a + s_ax * u)[None] + c * (np.cos(phi)[:, None] * r[0] * v
+                                                   + np.sin(phi)[:, None] * r[1] * w)
+                verts.extend(ring)
+                wp = min(0.5, max(0.0, 0.5 * (1 - s_ax / (0.2 * L)))) if parent >= 0 else 0.0
+                groups.extend([(j, 1 - wp, parent, wp)] * around)
+            for i in range(len(rings) - 1):
+                r0, r1 = base + i * around, base + (i + 1) * around
+                for k in range(around):
+                    k1 = (k + 1) % around
+                    faces.append((r0 + k, r0 + k1, r1 + k1, r1 + k))
+    return np.array(verts), np.array(faces), groups
+
+
+def build_scene(bpy, bvh_path: Path):
+    """Import the capture, build the skinned body, set up Workbench; returns the armature."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_anim.bvh(filepath=str(bvh_path), axis_forward="Y", axis_up="Z",
+                            frame_start=1, rotate_mode="NATIVE")
+    arm = bpy.context.selected_objects[0]
+    sk = skeleton_from_bvh(read_bvh(bvh_path))
+
+    P, faces, groups = _capsule_body(sk)
+    mesh = bpy.data.meshes.new("body")
+    mesh.from_pydata(P.tolist(), [], faces.tolist())
+    mesh.shade_smooth()
+    body = bpy.data.objects.new("body", mesh)
+    bpy.context.collection.objects.link(body)
+
+    # cloth-like colours, from the rest pose so they ride with the body
+    col = body.data.color_attributes.new("cloth", "FLOAT_COLOR", "POINT")
+    rgba = np.concatenate([cloth_colour(P), np.ones((len(P), 1))], 1)
+    col.data.foreach_set("color", rgba.astype(np.float32).ravel())
+    body.data.color_attributes.active_color = col
+
+    vgroups = {}
+    for vi, (j, wj, pj, wp) in enumerate(groups):
+        for jj, w in ((j, wj), (pj, wp)):
+            if jj < 0 or w <= 0:
+                continue
+            name = sk.names[jj]
+            if name not in vgroups:
+                vgroups[name] = body.vertex_groups.new(name=name)
+            vgroups[name].add([vi], float(w), "ADD")
+    mod = body.modifiers.new("armature", "ARMATURE")
+    mod.object = arm
+    body.parent = arm
+    arm.hide_render = True
+
+    scene = bpy.context.scene
+    scene.render.engine = "BLENDER_WORKBENCH"
+    scene.display.shading.light = "STUDIO"
+    scene.display.shading.color_type = "VERTEX"
+    scene.display.shading.show_shadows = False
+    scene.display.shading.show_cavity = False
+    scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "RGB"
+    scene.display_settings.display_device = "sRGB"
+    scene.view_settings.view_transform = "Standard"
+    world = bpy.data.worlds.new("stage")
+    world.color = (0.18, 0.17, 0.16)
+    scene.world = world
+    return arm, body
+
+
+def add_camera(bpy, name: str, R: np.ndarray):
+    from mathutils import Matrix
+
+    cam_data = bpy.data.cameras.new(name)
+    cam_data.type = "ORTHO"
+    cam_data.ortho_scale = WIDTH / PIXELS_PER_METRE
+    cam_data.clip_start, cam_data.clip_end = 0.01, 100.0
+    cam = bpy.data.objects.new(name, cam_data)
+    bpy.context.collection.objects.link(cam)
+    # Blender's camera looks down its local -z with +y up: columns x, -y, -z of ours
+    rot = R.T @ np.diag([1.0, -1.0, -1.0])
+    M = np.eye(4)
+    M[:3, :3] = rot
+    M[:3, 3] = STAGE_CENTRE - 10.0 * R[2]  # 10 m back along the viewing direction
+    cam.matrix_world = Matrix(M.tolist())
+    return cam
+
+
+def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dict:
+    import bpy
+    import cv2
+
+    out.mkdir(parents=True, exist_ok=True)
+    frames = list(range(first, last + 1, step))
+    meta = {"bvh": str(CMU_WALK), "frames": frames, "width": WIDTH, "height": HEIGHT,
+            "noise": NOISE_SIGMA, "version": 1}
+    stamp = out / "footage.json"
+    rots = camera_rotations()
+    todo = [(v, f) for v in views for f in frames
+            if not (out / v / f"{f:04d}.png").is_file()]
+    old = json.loads(stamp.read_text()) if stamp.is_file() else None
+    if old and {k: old[k] for k in ("width", "height", "noise", "version")} != {
+            k: meta[k] for k in ("width", "height", "noise", "version")}:
+        todo = [(v, f) for v in views for f in frames]
+    if todo:
+        arm, _ = build_scene(bpy, CMU_WALK)
+        scene = bpy.context.scene
+        cams = {v: add_camera(bpy, v, rots[v]) for v in views}
+        rng = np.random.default_rng(first * 7919 + last)
+        for v, f in todo:
+            (out / v).mkdir(exist_ok=True)
+            scene.camera = cams[v]
+            scene.frame_set(f + 1)  # the importer puts BVH frame 0 on Blender frame 1
+            path = out / v / f"{f:04d}.png"
+            scene.render.filepath = str(path)
+            bpy.ops.render.render(write_still=True)
+            img = cv2.imread(str(path)).astype(np.float32)
+            img += rng.normal(0, NOISE_SIGMA, img.shape)
+            cv2.imwrite(str(path), np.clip(img + 0.5, 0, 255).astype(np.uint8))
+    stamp.write_text(json.dumps(meta, indent=1))
+    truth = read_bvh(CMU_WALK)
+    truth.motion = truth.motion[frames]
+    truth.frame_time *= step
+    write_bvh(truth, out / "truth.bvh")
+    cams_json = {v: job_camera(rots[v]) for v in views}
+    (out / "cameras.json").write_text(json.dumps(cams_json, indent=1))
+    return {"frames": frames, "cameras": cams_json, "rendered": len(todo)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--first", type=int, default=300)
+    ap.add_argument("--last", type=int, default=772)
+    ap.add_argument("--step", type=int, default=4, help="capture frames per rendered frame")
+    ap.add_argument("--views", default="lateral,endon,oblique60")
+    a = ap.parse_args(argv)
+    info = render(a.out, a.first, a.last, a.step, a.views.split(","))
+    print(f"{len(info['frames'])} frames x {len(info['cameras'])} views in {a.out}"
+          f" ({info['rendered']} rendered now)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,94 @@
+"""Grey float images, Gaussian pyramids, gradients and bilinear sampling.
+
+Images are float32 arrays (height, width) with values in [0, 1]; pixel (x, y) is column x,
+row y, with integer coordinates at pixel centres. Level l of a pyramid halves the size l
+times: full-resolution pixel p sits at (p + 0.5) / 2**l - 0.5 on level l.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+# cv2.remap takes maps of at most 32767 columns
+_REMAP_COLS = 16384
+
+
+class ImageError(ValueError):
+    """An image that cannot be read; the message names the file."""
+
+
+def load_grey(path: str | Path) -> np.ndarray:
+    """Read an image file as float32 grey in [0, 1]."""
+    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ImageError(f"{path}: cannot read this image (missing, or not an image format)")
+    return to_grey(img)
+
+
+def to_grey(img: np.ndarray) -> np.ndarray:
+    """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 grey in [0, 1]."""
+    if img.dtype == np.uint8:
+        img = img.astype(np.float32) / 255
+    elif img.dtype == np.uint16:
+        img = img.astype(np.float32) / 65535
+    else:
+        img = img.astype(np.float32)
+    if img.ndim == 3:
+        img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2GRAY)
+    return np.ascontiguousarray(img)
+
+
+@dataclass
+class Level:
+    """One pyramid level: the image and its x, y derivatives stacked (H, W, 3), float32."""
+
+    stack: np.ndarray
+    scale: float  # full-resolution pixels per level pixel
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.stack.shape[:2]
+
+
+def pyramid(img: np.ndarray, levels: int, blur: float = 0.8) -> list[Level]:
+    """Gaussian pyramid with derivatives, finest level first; each level lightly pre-smoothed
+    (sigma ``blur`` level pixels) so that gradients see past the sensor noise."""
+    out = []
+    cur = img
+    for lv in range(levels):
+        sm = cv2.GaussianBlur(cur, (0, 0), blur) if blur > 0 else cur
+        gx = cv2.Sobel(sm, cv2.CV_32F, 1, 0, ksize=3, scale=1 / 8)
+        gy = cv2.Sobel(sm, cv2.CV_32F, 0, 1, ksize=3, scale=1 / 8)
+        out.append(Level(np.dstack([sm, gx, gy]), float(2**lv)))
+        if lv + 1 < levels:
+            cur = cv2.pyrDown(cur)
+    return out
+
+
+def to_level(pixels: np.ndarray, level: Level) -> np.ndarray:
+    """Full-resolution pixel coordinates (..., 2) to the level's coordinates."""
+    return (pixels + 0.5) / level.scale - 0.5
+
+
+def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bilinear samples (N, 3) = (I, dI/dx, dI/dy) at full-resolution pixels (N, 2), with the
+    derivatives per full-resolution pixel, and a mask of points inside the image."""
+    p = to_level(pixels, level).astype(np.float32)
+    N = len(p)
+    H, W = level.shape
+    inside = (p[:, 0] >= 0) & (p[:, 0] <= W - 1) & (p[:, 1] >= 0) & (p[:, 1] <= H - 1)
+    if N == 0:
+        return np.zeros((0, 3), np.float32), inside
+    cols = min(N, _REMAP_COLS)
+    rows = -(-N // cols)
+    pad = rows * cols - N
+    mx = np.pad(p[:, 0], (0, pad)).reshape(rows, cols)
+    my = np.pad(p[:, 1], (0, pad)).reshape(rows, cols)
+    vals = cv2.remap(level.stack, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    vals = vals.reshape(-1, 3)[:N].copy()
+    vals[:, 1:] /= level.scale
+    return vals, inside

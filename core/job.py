@@ -1,0 +1,263 @@
+"""The tracking job: a JSON file naming the skeleton, the initial pose, the views and the mode.
+
+This format is a public contract (``python -m core track JOB.json``): fields may be added,
+never removed or changed in meaning. Relative paths are relative to the job file's folder.
+
+.. code-block:: json
+
+    {"skeleton": {"bvh": "body.bvh",
+                  "joints": {"LeftHip": "ball", "LeftKnee": {"kind": "hinge", "axis": [1, 0, 0]}},
+                  "blobs": {"Chest": {"radius": 0.12}, "LeftCollar": false}},
+     "initial": {"bvh": "body.bvh", "frame": 0},
+     "views": [{"images": "lateral/*.png",
+                "camera": {"model": "scaled_orthographic", "R": [[1,0,0],[0,1,0],[0,0,1]],
+                           "t": [0, 0, 0], "scale": 100, "center": [240, 180]}}],
+     "mode": "calibrated",
+     "settings": {"levels": 3},
+     "frame_time": 0.0667}
+
+A camera maps a world point X (the BVH's units) to pixel = scale * (R X + t)[:2] + center,
+x right, y down. Joints not named under ``joints`` keep their initial rotation. A blob entry
+sets the short radius (``radius``, or two ``radii``) of every blob of that joint, or
+``false`` to drop them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import glob
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import se3
+from .bvh import BvhError, BvhFile, read_bvh
+from .camera import View
+from .pose import CALIBRATED, INDEPENDENT, BodyPose
+from .skeleton import BALL, FIXED, HINGE, Skeleton, skeleton_from_bvh
+from .tracker import TrackerSettings
+
+
+class JobError(ValueError):
+    """A job that cannot run; the message names the field and what is expected."""
+
+
+@dataclass
+class Job:
+    skeleton: Skeleton
+    bvh: BvhFile  # the skeleton's BVH: hierarchy and channel layout of the output
+    initial: BodyPose
+    images: list[list[str]]  # per view, per frame
+    cameras: list[View]  # the cameras as given (the initial pose's views start as copies)
+    mode: str
+    settings: TrackerSettings
+    frame_time: float
+
+
+def _field(d: dict, key: str, where: str, kind=None):
+    if not isinstance(d, dict) or key not in d:
+        raise JobError(f"{where}: missing field '{key}'")
+    v = d[key]
+    if kind is not None and not isinstance(v, kind):
+        names = kind.__name__ if isinstance(kind, type) else "/".join(k.__name__ for k in kind)
+        raise JobError(f"{where}.{key}: expected {names}, got {type(v).__name__}")
+    return v
+
+
+def _vector(v, n: int, where: str) -> np.ndarray:
+    try:
+        a = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise JobError(f"{where}: expected {n} numbers, got {v!r}") from None
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise JobError(f"{where}: expected {n} finite numbers, got {v!r}")
+    return a
+
+
+def parse_camera(d, where: str) -> View:
+    if not isinstance(d, dict):
+        raise JobError(f"{where}: expected an object with model, R, t, scale, center")
+    model = _field(d, "model", where, str)
+    if model != "scaled_orthographic":
+        raise JobError(f"{where}.model: only 'scaled_orthographic' is supported, got '{model}'")
+    try:
+        R = np.asarray(_field(d, "R", where), dtype=float)
+    except (TypeError, ValueError):
+        raise JobError(f"{where}.R: expected a 3x3 rotation matrix (list of 3 rows)") from None
+    if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-4) or np.linalg.det(
+        R
+    ) < 0:
+        raise JobError(f"{where}.R: expected a 3x3 rotation matrix (orthonormal, det +1)")
+    t = _vector(_field(d, "t", where), 3, f"{where}.t")
+    scale = _field(d, "scale", where, (int, float))
+    if not scale > 0:
+        raise JobError(f"{where}.scale: expected pixels per world unit > 0, got {scale}")
+    center = _vector(_field(d, "center", where), 2, f"{where}.center")
+    return View(se3.Similarity(scale, R, t), center)
+
+
+def _images(spec, base: Path, where: str) -> list[str]:
+    if isinstance(spec, str):
+        paths = sorted(glob.glob(str(base / spec)))
+        if not paths:
+            raise JobError(f"{where}: the pattern '{spec}' matches no file (relative to {base})")
+        return paths
+    if isinstance(spec, list) and all(isinstance(p, str) for p in spec):
+        paths = [str(base / p) for p in spec]
+        missing = [p for p in paths if not Path(p).is_file()]
+        if missing:
+            raise JobError(f"{where}: {len(missing)} image(s) not found, first: {missing[0]}")
+        return paths
+    raise JobError(f"{where}: expected a glob pattern or a list of image paths")
+
+
+def _apply_joints(sk: Skeleton, spec, where: str) -> None:
+    if not isinstance(spec, dict) or not spec:
+        raise JobError(f"{where}: expected an object naming the tracked joints")
+    for name, js in spec.items():
+        if name not in sk.names:
+            raise JobError(f"{where}.{name}: no such joint in the BVH; it has {', '.join(sk.names)}")
+        j = sk.names.index(name)
+        kind = js if isinstance(js, str) else js.get("kind") if isinstance(js, dict) else None
+        if kind not in (BALL, HINGE, FIXED):
+            raise JobError(f"{where}.{name}: expected 'ball', 'fixed' or {{\"kind\": \"hinge\","
+                           f" \"axis\": [x, y, z]}}, got {js!r}")
+        if j == 0 and kind != FIXED:
+            raise JobError(f"{where}.{name}: the root moves with the view poses; track its"
+                           " children instead")
+        sk.kinds[j] = kind
+        if kind == HINGE:
+            if not isinstance(js, dict) or "axis" not in js:
+                raise JobError(f"{where}.{name}: a hinge needs an 'axis' in the joint's local frame")
+            a = _vector(js["axis"], 3, f"{where}.{name}.axis")
+            if np.linalg.norm(a) < 1e-9:
+                raise JobError(f"{where}.{name}.axis: the axis must not be zero")
+            sk.axes[j] = a / np.linalg.norm(a)
+
+
+def _apply_blobs(sk: Skeleton, spec, where: str) -> None:
+    if not isinstance(spec, dict):
+        raise JobError(f"{where}: expected an object of joint name -> blob settings")
+    for name, bs in spec.items():
+        if name not in sk.names:
+            raise JobError(f"{where}.{name}: no such joint in the BVH")
+        j = sk.names.index(name)
+        if bs is False:
+            sk.blobs = [b for b in sk.blobs if b.joint != j]
+            continue
+        if not isinstance(bs, dict) or not ({"radius", "radii"} & bs.keys()):
+            raise JobError(f"{where}.{name}: expected {{\"radius\": r}}, {{\"radii\": [r1, r2]}}"
+                           " or false")
+        r = _vector(bs["radii"], 2, f"{where}.{name}.radii") if "radii" in bs else np.full(
+            2, float(bs["radius"]))
+        if np.any(r <= 0):
+            raise JobError(f"{where}.{name}: radii must be positive")
+        for b in sk.blobs:
+            if b.joint == j:
+                b.radii[1:] = r
+
+
+def _settings(spec, where: str) -> TrackerSettings:
+    if spec is None:
+        return TrackerSettings()
+    if not isinstance(spec, dict):
+        raise JobError(f"{where}: expected an object of tracker settings")
+    fields = {f.name: f for f in dataclasses.fields(TrackerSettings)}
+    kw = {}
+    for k, v in spec.items():
+        if k not in fields:
+            raise JobError(f"{where}.{k}: unknown setting; known: {', '.join(fields)}")
+        default = fields[k].default
+        if isinstance(default, bool) and not isinstance(v, bool) or not isinstance(
+            default, bool) and (isinstance(v, bool) or not isinstance(v, (int, float))):
+            raise JobError(f"{where}.{k}: expected a {type(default).__name__}, got {v!r}")
+        kw[k] = type(default)(v)
+    try:
+        return TrackerSettings(**kw)
+    except ValueError as e:
+        raise JobError(f"{where}: {e}") from None
+
+
+def initial_pose(sk: Skeleton, bvh: BvhFile, frame: int, cameras: list[View]) -> BodyPose:
+    R, root = bvh.frame_pose(frame)
+    return BodyPose(R, root, [c.copy() for c in cameras])
+
+
+def load_job(path: str | Path) -> Job:
+    """Read and validate a job file; raises JobError naming the first bad field."""
+    path = Path(path)
+    try:
+        d = json.loads(path.read_text())
+    except OSError as e:
+        raise JobError(f"{path}: cannot read the job file ({e.strerror})") from None
+    except json.JSONDecodeError as e:
+        raise JobError(f"{path}: not valid JSON (line {e.lineno}: {e.msg})") from None
+    base = path.parent
+    where = path.name
+    if not isinstance(d, dict):
+        raise JobError(f"{where}: expected a JSON object")
+
+    sk_spec = _field(d, "skeleton", where, dict)
+    bvh_path = base / _field(sk_spec, "bvh", f"{where}.skeleton", str)
+    try:
+        bvh = read_bvh(bvh_path)
+    except BvhError as e:
+        raise JobError(f"{where}.skeleton.bvh: {e}") from None
+    sk = skeleton_from_bvh(bvh)
+    _apply_joints(sk, _field(sk_spec, "joints", f"{where}.skeleton"), f"{where}.skeleton.joints")
+    sk.blobs = sk.default_blobs()
+    if "blobs" in sk_spec:
+        _apply_blobs(sk, sk_spec["blobs"], f"{where}.skeleton.blobs")
+
+    init = _field(d, "initial", where, dict)
+    init_path = base / _field(init, "bvh", f"{where}.initial", str)
+    frame = _field(init, "frame", f"{where}.initial", int) if "frame" in init else 0
+    try:
+        init_bvh = bvh if init_path == bvh_path else read_bvh(init_path)
+    except BvhError as e:
+        raise JobError(f"{where}.initial.bvh: {e}") from None
+    if init_bvh.names != bvh.names:
+        raise JobError(f"{where}.initial.bvh: its hierarchy differs from the skeleton's BVH")
+    if not 0 <= frame < len(init_bvh.motion):
+        raise JobError(
+            f"{where}.initial.frame: {frame} is outside 0..{len(init_bvh.motion) - 1}"
+        )
+
+    views = _field(d, "views", where, list)
+    if not views:
+        raise JobError(f"{where}.views: expected at least one view")
+    images, cameras = [], []
+    for i, v in enumerate(views):
+        w = f"{where}.views[{i}]"
+        images.append(_images(_field(v, "images", w), base, f"{w}.images"))
+        cameras.append(parse_camera(_field(v, "camera", w), f"{w}.camera"))
+    counts = {len(x) for x in images}
+    if len(counts) > 1:
+        raise JobError(f"{where}.views: every view needs the same number of frames, got "
+                       + ", ".join(str(len(x)) for x in images))
+    if min(counts) < 2:
+        raise JobError(f"{where}.views: at least two frames are needed to track")
+
+    mode = d.get("mode", INDEPENDENT)
+    if mode not in (CALIBRATED, INDEPENDENT):
+        raise JobError(f"{where}.mode: expected 'calibrated' or 'independent', got {mode!r}")
+    settings = _settings(d.get("settings"), f"{where}.settings")
+    ft = d.get("frame_time", bvh.frame_time)
+    if not isinstance(ft, (int, float)) or ft <= 0:
+        raise JobError(f"{where}.frame_time: expected seconds per frame > 0, got {ft!r}")
+    pose = initial_pose(sk, init_bvh, frame, cameras)
+    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft))
+
+
+def world_root(job: Job, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:
+    """Root world rotation (3, 3) and position (3,) of a tracked pose. In independent mode the
+    root is read through the first view: the given camera undoes that view's tracked pose."""
+    if job.mode == CALIBRATED:
+        return pose.rotations[0], pose.root_position
+    cam, eff = job.cameras[0].pose, pose.views[0].pose
+    R = cam.R.T @ eff.R @ pose.rotations[0]
+    q = eff.apply(pose.root_position)
+    p = cam.R.T @ (q / cam.s - cam.t)
+    return R, p

@@ -1,0 +1,88 @@
+"""The per-pixel rows [H | J] of the linear motion model, one view at a time.
+
+A body point at scaled camera coordinate q = (x, y, z) with image gradient g = (Ix, Iy, 0)
+gives one brightness-constancy row A_i with  I_t + A_i . delta = 0  (paper eqs. 18, 28, 33).
+
+* Independent mode, this view's root block (about the root's image point q_r, d = q - q_r):
+  [g.d, Ix, Iy, (d x g)]  -- paper eq. 18 with the pivot moved to q_r.
+* Calibrated mode, the shared world root (about the root's world position c, c' its scaled
+  camera point, camera rotation R, scale s):  [s R^T g, R^T((q - c') x g)].
+* One column per joint degree of freedom, with its axis w' and a point o' on it carried into
+  scaled camera coordinates and v' = o' x w' (eq. 26):  g . v' + w' . (q x g), zero on pixels
+  whose segment that joint does not move (eq. 30).
+
+Everything is vectorised over pixels; the joint block is two (N, 3) x (3, D) products.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .camera import View
+from .pose import CALIBRATED, ROOT_PARAMS, BodyPose, n_root_params
+from .skeleton import Skeleton
+
+
+class Kinematics:
+    """What every view's rows need from one pose: joint frames, segment motions, and the
+    degrees of freedom as world axes through world points."""
+
+    def __init__(self, skeleton: Skeleton, pose: BodyPose):
+        self.skeleton = skeleton
+        self.pose = pose
+        self.frames = skeleton.joint_frames(pose.rotations, pose.root_position)
+        self.segments = skeleton.segment_motions(self.frames)
+        self.dof_joint, dof_axis = skeleton.dof_joints_and_axes()
+        R = self.frames[self.dof_joint, :3, :3]
+        self.dof_axis_world = np.einsum("dab,db->da", R, dof_axis)
+        self.dof_point_world = self.frames[self.dof_joint, :3, 3]
+        self.moves = skeleton.moved_by()[:, self.dof_joint]  # (J, D)
+
+    def world_points(self, seg_joint: np.ndarray, ref_points: np.ndarray) -> np.ndarray:
+        """World positions (N, 3) of reference-frame points on the segments of ``seg_joint``."""
+        g = self.segments[seg_joint]
+        return np.einsum("nab,nb->na", g[:, :3, :3], ref_points) + g[:, :3, 3]
+
+
+def _cross_g(q: np.ndarray, grad: np.ndarray) -> np.ndarray:
+    """q x (Ix, Iy, 0) for q (N, 3), grad (N, 2)."""
+    gx, gy = grad[:, 0], grad[:, 1]
+    return np.stack([-q[:, 2] * gy, q[:, 2] * gx, q[:, 0] * gy - q[:, 1] * gx], 1)
+
+
+def rows(
+    kin: Kinematics,
+    view_index: int,
+    mode: str,
+    seg_joint: np.ndarray,
+    q: np.ndarray,
+    grad: np.ndarray,
+) -> np.ndarray:
+    """Rows (N, P) of one view for points on segments ``seg_joint`` (N,) at scaled camera
+    coordinates q (N, 3) with image gradients ``grad`` (N, 2) per full-resolution pixel."""
+    view: View = kin.pose.views[view_index]
+    n_views = len(kin.pose.views)
+    nr = n_root_params(mode, n_views)
+    D = len(kin.dof_joint)
+    N = len(q)
+    A = np.zeros((N, nr + D))
+    root_c = view.scaled(kin.frames[0, :3, 3])
+    qxg = _cross_g(q, grad)
+    if mode == CALIBRATED:
+        Rt, s = view.pose.R.T, view.pose.s
+        g3 = np.concatenate([grad, np.zeros((N, 1))], 1)
+        A[:, 0:3] = s * g3 @ Rt.T
+        A[:, 3:6] = (qxg - np.cross(root_c, g3)) @ Rt.T
+    else:
+        d = q - root_c
+        o = ROOT_PARAMS * view_index
+        A[:, o] = grad[:, 0] * d[:, 0] + grad[:, 1] * d[:, 1]
+        A[:, o + 1 : o + 3] = grad
+        A[:, o + 3 : o + 6] = _cross_g(d, grad)
+    if D:
+        w_cam = kin.dof_axis_world @ view.pose.R.T  # (D, 3)
+        o_cam = view.scaled(kin.dof_point_world)  # (D, 3)
+        v_cam = np.cross(o_cam, w_cam)
+        J = grad @ v_cam[:, :2].T + qxg @ w_cam.T
+        A[:, nr:] = J * kin.moves[seg_joint]
+    return A

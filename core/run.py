@@ -1,0 +1,78 @@
+"""Running a tracking job end to end: load, track, write the BVH and the report."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from .job import Job, world_root
+from .tracker import FrameResult, Tracker, TrackResult, track
+
+
+def run_job(
+    job: Job,
+    progress: Callable[[FrameResult, int, int], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+) -> TrackResult:
+    """Track every frame of the job's footage from its first frame."""
+    tracker = Tracker(job.skeleton, job.images, job.mode, job.settings)
+    frames = list(range(len(job.images[0])))
+    return track(tracker, job.initial, frames, progress, cancel)
+
+
+def result_bvh(job: Job, result: TrackResult):
+    """The job's BVH hierarchy holding one frame per tracked frame."""
+    rots, roots = [], []
+    for fr in result.frames:
+        R0, p0 = world_root(job, fr.pose)
+        R = fr.pose.rotations.copy()
+        R[0] = R0
+        rots.append(R)
+        roots.append(p0)
+    out = job.bvh.with_motion(np.array(rots), np.array(roots))
+    out.frame_time = job.frame_time
+    return out
+
+
+def report(job: Job, result: TrackResult, seconds: float) -> dict:
+    """Per-frame residual, iterations, convergence and timing, with a summary."""
+    tracked = result.frames[1:]
+    iters = sum(f.iterations for f in tracked)
+    return {
+        "mode": job.mode,
+        "views": len(job.images),
+        "degrees_of_freedom": len(job.skeleton.dof_names()),
+        "frames_total": len(job.images[0]),
+        "frames_tracked": len(result.frames),
+        "cancelled": result.cancelled,
+        "diverged_frames": result.diverged_frames,
+        "seconds": seconds,
+        "frames_per_second": len(tracked) / seconds if seconds > 0 else None,
+        "seconds_per_iteration": sum(f.seconds for f in tracked) / iters if iters else None,
+        "frames": [
+            {
+                "frame": f.frame,
+                "residual": f.residual,
+                "iterations": f.iterations,
+                "converged": f.converged,
+                "diverged": f.diverged,
+                "reason": f.reason,
+                "seconds": f.seconds,
+            }
+            for f in result.frames
+        ],
+    }
+
+
+def write_report(path: str | Path, rep: dict) -> None:
+    Path(path).write_text(json.dumps(rep, indent=1, allow_nan=True))
+
+
+def timed_run(job: Job, progress=None, cancel=None) -> tuple[TrackResult, float]:
+    t0 = time.perf_counter()
+    res = run_job(job, progress, cancel)
+    return res, time.perf_counter() - t0

@@ -1,0 +1,270 @@
+"""The body: a tree of joints, each a hinge, a ball or fixed, with one ellipsoid per segment.
+
+Frames and units. The reference frame is the rest pose, in which every joint frame is aligned
+with the world (as in BVH); lengths are in the skeleton's own units (a BVH's). A joint's local
+rotation R_j turns its subtree about its rest position p_j, so the motion of segment k is the
+product of exponentials of paper eq. 23,
+
+.. math:: g_k = T(x_0) R_0 T(-p_0) \\prod_{j \\in chain(k)} e^{\\hat\\xi_j \\theta_j},
+          \\qquad \\xi_j = (-\\omega_j \\times p_j, \\omega_j),
+
+with M_j = g_j T(p_j) the world frame of joint j. A tracked hinge adds one degree of freedom
+about a unit axis in the joint's local frame (R_j <- R_j exp(d a)); a ball adds three, about its
+local x, y, z axes; a fixed joint keeps its initial rotation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import se3
+from .bvh import BvhFile
+
+BALL, HINGE, FIXED = "ball", "hinge", "fixed"
+
+
+@dataclass
+class Ellipsoid:
+    """A blob rigidly attached to the segment moved by ``joint``, in the reference frame.
+
+    Points x with |diag(1/radii) Q^T (x - centre)| = 1; Q's columns are the blob's axes.
+    """
+
+    joint: int
+    name: str
+    centre: np.ndarray
+    radii: np.ndarray
+    Q: np.ndarray
+
+
+@dataclass
+class Skeleton:
+    """Joints in topological order (parents first); ``parents[0] == -1`` is the root."""
+
+    names: list[str]
+    parents: np.ndarray
+    offsets: np.ndarray  # (J, 3) offset from the parent's rest position
+    kinds: list[str] = field(default_factory=list)
+    axes: np.ndarray | None = None  # (J, 3) hinge axes in the joint's local frame
+    end_sites: list[list[np.ndarray]] = field(default_factory=list)
+    blobs: list[Ellipsoid] = field(default_factory=list)
+
+    def __post_init__(self):
+        J = len(self.names)
+        self.parents = np.asarray(self.parents, dtype=int)
+        self.offsets = np.asarray(self.offsets, dtype=float).reshape(J, 3)
+        if not self.kinds:
+            self.kinds = [FIXED] * J
+        if self.axes is None:
+            self.axes = np.tile([1.0, 0.0, 0.0], (J, 1))
+        if not self.end_sites:
+            self.end_sites = [[] for _ in range(J)]
+        for j, p in enumerate(self.parents):
+            if j == 0 and p != -1 or j > 0 and not 0 <= p < j:
+                raise ValueError(f"joint '{self.names[j]}': parents must come before children")
+        self.rest_positions = np.zeros((J, 3))
+        for j in range(J):
+            base = self.rest_positions[self.parents[j]] if j else 0.0
+            self.rest_positions[j] = base + self.offsets[j]
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.names)
+
+    def index(self, name: str) -> int:
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise KeyError(
+                f"no joint named '{name}'; the skeleton has: {', '.join(self.names)}"
+            ) from None
+
+    def children(self, j: int) -> list[int]:
+        return [int(c) for c in np.flatnonzero(self.parents == j)]
+
+    def ancestors(self, j: int) -> list[int]:
+        """j and its ancestors up to the root, j first."""
+        out = []
+        while j >= 0:
+            out.append(j)
+            j = int(self.parents[j])
+        return out
+
+    def height(self) -> float:
+        """Largest extent of the rest pose (joints and end sites), a size for default radii."""
+        pts = [self.rest_positions]
+        for j, ends in enumerate(self.end_sites):
+            pts += [self.rest_positions[j] + e for e in ends]
+        P = np.vstack(pts)
+        return float(np.max(P.max(0) - P.min(0)))
+
+    # --- degrees of freedom -------------------------------------------------------------
+    def dof_joints_and_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per degree of freedom: its joint and unit axis in the joint's local frame."""
+        joints, axes = [], []
+        for j, kind in enumerate(self.kinds):
+            if kind == BALL:
+                joints += [j, j, j]
+                axes += list(np.eye(3))
+            elif kind == HINGE:
+                a = np.asarray(self.axes[j], dtype=float)
+                joints.append(j)
+                axes.append(a / np.linalg.norm(a))
+        return np.array(joints, dtype=int), np.array(axes, dtype=float).reshape(-1, 3)
+
+    def dof_names(self) -> list[str]:
+        names = []
+        for j, kind in enumerate(self.kinds):
+            if kind == BALL:
+                names += [f"{self.names[j]}.{c}" for c in "xyz"]
+            elif kind == HINGE:
+                names.append(self.names[j])
+        return names
+
+    def moved_by(self) -> np.ndarray:
+        """Boolean (J, J): ``[m, j]`` is True when joint j's rotation moves joint m's segment."""
+        M = np.zeros((self.n_joints, self.n_joints), dtype=bool)
+        for m in range(self.n_joints):
+            M[m, self.ancestors(m)] = True
+        return M
+
+    # --- forward kinematics --------------------------------------------------------------
+    def joint_frames(self, rotations: np.ndarray, root_position: np.ndarray) -> np.ndarray:
+        """World frames M_j (J, 4, 4) of every joint for local rotations (J, 3, 3)."""
+        J = self.n_joints
+        M = np.empty((J, 4, 4))
+        M[0] = se3.rigid(rotations[0], root_position)
+        for j in range(1, J):
+            p = self.parents[j]
+            M[j, :3, :3] = M[p, :3, :3] @ rotations[j]
+            M[j, :3, 3] = M[p, :3, :3] @ self.offsets[j] + M[p, :3, 3]
+            M[j, 3] = (0, 0, 0, 1)
+        return M
+
+    def segment_motions(self, frames: np.ndarray) -> np.ndarray:
+        """g_j = M_j T(-p_j) (J, 4, 4): reference-frame points of segment j to the world."""
+        g = frames.copy()
+        g[:, :3, 3] -= np.einsum("jab,jb->ja", frames[:, :3, :3], self.rest_positions)
+        return g
+
+    def world_positions(self, rotations: np.ndarray, root_position: np.ndarray) -> np.ndarray:
+        """World positions of every joint (J, 3)."""
+        return self.joint_frames(rotations, root_position)[:, :3, 3]
+
+    # --- blobs ------------------------------------------------------------------------
+    def default_blobs(
+        self, radius_ratio: float = 0.16, min_radius_ratio: float = 0.022, min_length_ratio=0.03
+    ) -> list[Ellipsoid]:
+        """One ellipsoid per bone (joint to child or end site) long enough to see.
+
+        Long radius half the bone, short radii max(radius_ratio * length,
+        min_radius_ratio * height); bones shorter than min_length_ratio * height get none.
+        """
+        H = self.height()
+        blobs = []
+        for j in range(self.n_joints):
+            tips = [self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
+            for k, d in enumerate(tips):
+                L = float(np.linalg.norm(d))
+                if L < min_length_ratio * H:
+                    continue
+                r = max(radius_ratio * L, min_radius_ratio * H)
+                name = self.names[j] if len(tips) == 1 else f"{self.names[j]}.{k}"
+                blobs.append(bone_blob(j, name, self.rest_positions[j], d, r))
+        return blobs
+
+
+def bone_blob(joint: int, name: str, head: np.ndarray, direction: np.ndarray, r) -> Ellipsoid:
+    """Ellipsoid along a bone from head to head + direction with short radii r (or (r1, r2))."""
+    L = float(np.linalg.norm(direction))
+    u = direction / L
+    helper = np.eye(3)[int(np.argmin(np.abs(u)))]
+    v = np.cross(u, helper)
+    v /= np.linalg.norm(v)
+    w = np.cross(u, v)
+    r1, r2 = np.broadcast_to(np.asarray(r, dtype=float), (2,))
+    return Ellipsoid(
+        joint, name, head + direction / 2, np.array([L / 2, r1, r2]), np.stack([u, v, w], 1)
+    )
+
+
+def skeleton_from_bvh(bvh: BvhFile) -> Skeleton:
+    """Hierarchy, offsets and end sites of a BVH file; every joint fixed, no blobs yet."""
+    return Skeleton(
+        names=bvh.names,
+        parents=[j.parent for j in bvh.joints],
+        offsets=np.array([j.offset for j in bvh.joints]),
+        end_sites=[list(j.end_sites) for j in bvh.joints],
+    )
+
+
+# --- templates -------------------------------------------------------------------------
+def _build(spec, end_sites=None) -> Skeleton:
+    names = [s[0] for s in spec]
+    parents = [names.index(s[1]) if s[1] else -1 for s in spec]
+    sk = Skeleton(
+        names=names,
+        parents=parents,
+        offsets=[s[2] for s in spec],
+        kinds=[s[3] for s in spec],
+        axes=np.array([s[4] if len(s) > 4 else (1, 0, 0) for s in spec], dtype=float),
+        end_sites=[[np.asarray(e, float)] if e is not None else [] for e in end_sites]
+        if end_sites
+        else None,
+    )
+    sk.blobs = sk.default_blobs()
+    return sk
+
+
+def human_template() -> Skeleton:
+    """The paper's 19-DOF human, metres, y up, facing +z: 3-DOF hips, shoulders and neck,
+    1-DOF knees and elbows (flexion about local x)."""
+    spec = [
+        ("Hips", None, (0, 0.95, 0), FIXED),
+        ("Spine", "Hips", (0, 0.1, 0), FIXED),
+        ("Chest", "Spine", (0, 0.3, 0), FIXED),
+        ("Neck", "Chest", (0, 0.15, 0), BALL),
+        ("LeftShoulder", "Chest", (0.18, 0.1, 0), BALL),
+        ("LeftElbow", "LeftShoulder", (0, -0.28, 0), HINGE, (1, 0, 0)),
+        ("RightShoulder", "Chest", (-0.18, 0.1, 0), BALL),
+        ("RightElbow", "RightShoulder", (0, -0.28, 0), HINGE, (1, 0, 0)),
+        ("LeftHip", "Hips", (0.09, -0.05, 0), BALL),
+        ("LeftKnee", "LeftHip", (0, -0.42, 0), HINGE, (1, 0, 0)),
+        ("RightHip", "Hips", (-0.09, -0.05, 0), BALL),
+        ("RightKnee", "RightHip", (0, -0.42, 0), HINGE, (1, 0, 0)),
+    ]
+    ends = [None, None, None, (0, 0.25, 0), None, (0, -0.27, 0), None, (0, -0.27, 0), None,
+            (0, -0.43, 0), None, (0, -0.43, 0)]
+    return _build(spec, ends)
+
+
+def walker_template() -> Skeleton:
+    """A 6-DOF frontoparallel walker seen from its side (+x is forward, y up, z toward the
+    camera): hinges at hips, knees and ankles, all about z."""
+    z = (0, 0, 1)
+    spec = [
+        ("Hips", None, (0, 0.95, 0), FIXED),
+        ("Torso", "Hips", (0, 0.05, 0), FIXED),
+        ("LeftHip", "Hips", (0, -0.05, 0.09), HINGE, z),
+        ("LeftKnee", "LeftHip", (0, -0.42, 0), HINGE, z),
+        ("LeftAnkle", "LeftKnee", (0, -0.43, 0), HINGE, z),
+        ("RightHip", "Hips", (0, -0.05, -0.09), HINGE, z),
+        ("RightKnee", "RightHip", (0, -0.42, 0), HINGE, z),
+        ("RightAnkle", "RightKnee", (0, -0.43, 0), HINGE, z),
+    ]
+    ends = [None, (0, 0.6, 0), None, None, (0.2, -0.05, 0), None, None, (0.2, -0.05, 0)]
+    return _build(spec, ends)
+
+
+def planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1)) -> Skeleton:
+    """A chain along +x whose hinges all turn about ``axis`` (the view direction), for a limb
+    or an animal seen from the side."""
+    spec = [("Base", None, (0, 0, 0), FIXED)]
+    for i, L in enumerate(lengths):
+        parent = spec[-1][0]
+        offset = (lengths[i - 1], 0, 0) if i else (0, 0, 0)
+        spec.append((f"Link{i + 1}", parent, offset, HINGE, axis))
+    ends = [None] * len(lengths) + [(lengths[-1], 0, 0)]
+    return _build(spec, ends)

@@ -1,0 +1,318 @@
+"""The tracking recipe: predict, then Gauss-Newton coarse to fine, frame after frame.
+
+For each new frame the pose is predicted from the last two (constant velocity), then refined
+on an image pyramid from the coarsest level to the finest. Each iteration maps the body's
+pixels of two earlier frames -- the previous frame and the key frame (the first, user-posed
+one; it holds the track against drift) -- to the new frame under the current estimate,
+samples the new image there, and solves one linear system for all views (paper section 2.5).
+Pixels whose front-most blob in the new frame is not the blob they came from are left out
+(a leg passing behind the other); pixel weights are the blob's rim weight times the EM support
+posterior. A frame whose residual jumps, whose body leaves the images or whose system is
+degenerate is reported as diverged instead of being accepted.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import image as imagelib
+from . import raycast
+from .linearize import Kinematics, rows
+from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
+from .skeleton import Skeleton
+from .solver import DegenerateSystem, NormalEquations, robust_scale, solve, support_weights
+
+
+@dataclass
+class TrackerSettings:
+    """Tracker knobs with their defaults; every field can be set from a job's ``settings``."""
+
+    levels: int = 3  # pyramid levels (1 = full resolution only)
+    iterations: int = 6  # Gauss-Newton iterations per level at most
+    pixel_step: int = 1  # use every n-th pixel (both directions) at the finest level
+    key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
+    damping: float = 1e-3  # Levenberg-Marquardt damping, relative to each unknown's information
+    prior: float = 1e-3  # pull toward the predicted pose, same scaling
+    outlier_density: float = 0.1  # EM support map: flat outlier density (see solver)
+    noise_floor: float = 0.01  # smallest residual scale, image units (0..1)
+    rim_width: float = 0.3  # blob outline band: weight rises from 0 to 1 across this part
+    prediction_gain: float = 1.0  # constant-velocity prediction (0 = hold the last pose)
+    converge_pixels: float = 0.05  # stop iterating when no blob moves more (level pixels)
+    divergence_ratio: float = 3.0  # residual over the running median that flags divergence
+    min_inside: float = 0.5  # fraction of body pixels that must stay inside the images
+    stop_on_divergence: bool = True
+
+    def __post_init__(self):
+        for name in ("levels", "iterations", "pixel_step"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"settings.{name} must be a whole number >= 1")
+
+
+@dataclass
+class FrameResult:
+    """One tracked frame: its pose and the facts the UI, the report and the benchmark read."""
+
+    frame: int
+    pose: BodyPose
+    residual: float  # robust RMS of the finest level's last iteration, image units
+    iterations: int
+    converged: bool
+    diverged: bool = False
+    reason: str = ""
+    seconds: float = 0.0
+
+
+@dataclass
+class TrackResult:
+    frames: list[FrameResult] = field(default_factory=list)
+    cancelled: bool = False
+
+    @property
+    def diverged_frames(self) -> list[int]:
+        return [f.frame for f in self.frames if f.diverged]
+
+
+@dataclass
+class _PointSet:
+    """Body pixels of one earlier frame in one view, ready to be mapped to the new frame."""
+
+    view: int
+    seg_joint: np.ndarray  # (N,) joint whose segment holds the point
+    blob: np.ndarray  # (N,) blob index, for the visibility test
+    ref: np.ndarray  # (N, 3) reference-frame point
+    value: np.ndarray  # (N,) intensity in that frame
+    weight: np.ndarray  # (N,) rim weight times the set's weight
+
+
+class ImageSequence:
+    """Frames of every view, read on demand: ``images[view][frame]`` is a path or an array."""
+
+    def __init__(self, images: Sequence[Sequence], levels: int):
+        self.images = images
+        self.levels = levels
+        self._cache: dict[tuple[int, int], list[imagelib.Level]] = {}
+
+    @property
+    def n_views(self) -> int:
+        return len(self.images)
+
+    def n_frames(self) -> int:
+        return min(len(v) for v in self.images)
+
+    def pyramid(self, view: int, frame: int) -> list[imagelib.Level]:
+        key = (view, frame)
+        if key not in self._cache:
+            src = self.images[view][frame]
+            img = imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
+            self._cache[key] = imagelib.pyramid(img, self.levels)
+        return self._cache[key]
+
+    def keep_only(self, keys: set[tuple[int, int]]) -> None:
+        for k in list(self._cache):
+            if k not in keys:
+                del self._cache[k]
+
+
+class Tracker:
+    """Tracks a skeleton through the frames of one or more views."""
+
+    def __init__(
+        self,
+        skeleton: Skeleton,
+        images: Sequence[Sequence],
+        mode: str = INDEPENDENT,
+        settings: TrackerSettings | None = None,
+    ):
+        if mode not in (CALIBRATED, INDEPENDENT):
+            raise ValueError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
+        if not skeleton.blobs:
+            raise ValueError("the skeleton has no blobs: give its segments ellipsoids")
+        self.skeleton = skeleton
+        self.mode = mode
+        self.settings = settings or TrackerSettings()
+        self.seq = ImageSequence(images, self.settings.levels)
+        self.n_dof = len(skeleton.dof_joints_and_axes()[0])
+        self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
+
+    # --- point sets ---------------------------------------------------------------------
+    def _point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
+                   set_weight: float) -> _PointSet:
+        level = self.seq.pyramid(view, frame)[lv]
+        step = self.settings.pixel_step if lv == 0 else 1
+        v_l = pose.views[view].at_level(lv)
+        pix_l, hits, _ = raycast.render_labels(
+            v_l, self.skeleton.blobs, kin.segments, level.shape, step
+        )
+        ok = hits.label >= 0
+        pix_l, label = pix_l[ok].astype(int), hits.label[ok]
+        seg_joint = np.array([b.joint for b in self.skeleton.blobs], dtype=int)[label]
+        g = kin.segments[seg_joint]
+        d = hits.world[ok] - g[:, :3, 3]
+        ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
+        value = level.stack[pix_l[:, 1], pix_l[:, 0], 0].astype(float)
+        rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
+        return _PointSet(view, seg_joint, label, ref, value, rim * set_weight)
+
+    def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int):
+        v_l = pose.views[view].at_level(lv)
+        pix, hits, box = raycast.render_labels(v_l, self.skeleton.blobs, kin.segments, shape)
+        lab = np.full(shape, -1, dtype=int)
+        if box is not None:
+            lab[pix[:, 1].astype(int), pix[:, 0].astype(int)] = hits.label
+        return lab
+
+    # --- one level -----------------------------------------------------------------------
+    def _accumulate(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet],
+                    levels: list, labels: list, stats: dict) -> NormalEquations:
+        s = self.settings
+        ne = NormalEquations.zeros(self.n_params)
+        for ps in sets:
+            view = est.views[ps.view]
+            X = kin.world_points(ps.seg_joint, ps.ref)
+            q = view.scaled(X)
+            pix = q[:, :2] + view.center
+            vals, inside = imagelib.sample(levels[ps.view], pix)
+            p_l = np.rint(imagelib.to_level(pix, levels[ps.view])).astype(int)
+            lab = labels[ps.view]
+            H, W = lab.shape
+            inb = (p_l[:, 0] >= 0) & (p_l[:, 0] < W) & (p_l[:, 1] >= 0) & (p_l[:, 1] < H)
+            visible = np.zeros(len(pix), dtype=bool)
+            visible[inb] = lab[p_l[inb, 1], p_l[inb, 0]] == ps.blob[inb]
+            ok = inside & visible
+            stats["points"] += len(pix)
+            stats["inside"] += int(inside.sum())
+            if not ok.any():
+                continue
+            r = vals[ok, 0] - ps.value[ok]
+            sigma = robust_scale(r, s.noise_floor)
+            w = ps.weight[ok] * support_weights(r, sigma, s.outlier_density)
+            A = rows(kin, ps.view, self.mode, ps.seg_joint[ok], q[ok], vals[ok, 1:3])
+            ne.add(A, r, w)
+        return ne
+
+    def _blob_pixels(self, pose: BodyPose) -> np.ndarray:
+        """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
+        kin_seg = self.skeleton.segment_motions(
+            self.skeleton.joint_frames(pose.rotations, pose.root_position)
+        )
+        out = []
+        for v in pose.views:
+            pts = [kin_seg[b.joint, :3, :3] @ b.centre + kin_seg[b.joint, :3, 3]
+                   for b in self.skeleton.blobs]
+            out.append(v.project(np.array(pts)))
+        return np.array(out)
+
+    def _track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
+                     predicted: BodyPose, frame: int) -> FrameResult:
+        s = self.settings
+        t0 = time.perf_counter()
+        est = predicted
+        offset = np.zeros(self.n_params)
+        total_iters = 0
+        converged = False
+        ne = None
+        stats = {"points": 0, "inside": 0}
+        kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
+        for lv in reversed(range(s.levels)):
+            levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
+            sets = []
+            for c in range(self.seq.n_views):
+                sets.append(self._point_set(prev, kin_prev, c, prev_frame, lv, 1.0))
+                if s.key_weight > 0 and key_frame != prev_frame:
+                    sets.append(self._point_set(key, kin_key, c, key_frame, lv, s.key_weight))
+            kin = Kinematics(self.skeleton, est)
+            labels = [self._label_map(est, kin, c, levels[c].shape, lv)
+                      for c in range(self.seq.n_views)]
+            converged = False
+            for _ in range(s.iterations):
+                stats = {"points": 0, "inside": 0}
+                ne = self._accumulate(est, kin, sets, levels, labels, stats)
+                delta = solve(ne, s.damping, s.prior, offset)
+                before = self._blob_pixels(est)
+                est = apply_update(self.skeleton, est, delta, self.mode)
+                offset += delta
+                total_iters += 1
+                kin = Kinematics(self.skeleton, est)
+                moved = np.max(np.linalg.norm(self._blob_pixels(est) - before, axis=-1))
+                if moved / 2**lv < s.converge_pixels:
+                    converged = True
+                    break
+        residual = float(np.sqrt(ne.cost / max(ne.weight, 1e-12))) if ne else float("nan")
+        result = FrameResult(frame, est, residual, total_iters, converged)
+        if stats["points"] and stats["inside"] / stats["points"] < s.min_inside:
+            result.diverged, result.reason = True, "the body left the image"
+        result.seconds = time.perf_counter() - t0
+        return result
+
+    # --- the sequence ----------------------------------------------------------------------
+    def iter_track(self, initial: BodyPose, frames: Sequence[int]) -> Iterator[FrameResult]:
+        """Track through ``frames`` (indices into every view's images, in tracking order; the
+        first is the frame ``initial`` is posed on). Yields one result per frame, the first
+        being the initial pose itself; stops after a divergence if the settings say so."""
+        frames = list(frames)
+        n = self.seq.n_frames()
+        for f in frames:
+            if not 0 <= f < n:
+                raise IndexError(f"frame {f} is outside the footage's 0..{n - 1}")
+        if len(initial.views) != self.seq.n_views:
+            raise ValueError(
+                f"the pose has {len(initial.views)} views, the footage {self.seq.n_views}"
+            )
+        key_frame = frames[0]
+        first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
+        yield first
+        history = [first]
+        residuals: list[float] = []
+        for frame in frames[1:]:
+            prev = history[-1]
+            if len(history) >= 2:
+                pred = extrapolate(history[-2].pose, prev.pose, self.settings.prediction_gain)
+            else:
+                pred = prev.pose.copy()
+            try:
+                res = self._track_frame(prev.pose, prev.frame, initial, key_frame, pred, frame)
+            except DegenerateSystem as e:
+                res = FrameResult(frame, pred, float("nan"), 0, False, True, str(e))
+            if not res.diverged:
+                if not all(np.isfinite(res.pose.rotations).flat):
+                    res.diverged, res.reason = True, "the solution is not finite"
+                elif residuals and res.residual > self.settings.divergence_ratio * max(
+                    float(np.median(residuals)), self.settings.noise_floor
+                ):
+                    res.diverged = True
+                    res.reason = (
+                        f"residual {res.residual:.4f} is over {self.settings.divergence_ratio}x"
+                        f" the median so far ({np.median(residuals):.4f})"
+                    )
+            residuals.append(res.residual)
+            self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
+                                for f in (key_frame, prev.frame, frame)})
+            yield res
+            if res.diverged and self.settings.stop_on_divergence:
+                return
+            history = history[-1:] + [res]
+
+
+def track(
+    tracker: Tracker,
+    initial: BodyPose,
+    frames: Sequence[int],
+    progress: Callable[[FrameResult, int, int], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+) -> TrackResult:
+    """Run ``Tracker.iter_track`` to the end, calling ``progress(result, done, total)`` after
+    each frame and stopping (keeping what was tracked) when ``cancel()`` returns True."""
+    out = TrackResult()
+    total = len(frames)
+    for res in tracker.iter_track(initial, frames):
+        out.frames.append(res)
+        if progress:
+            progress(res, len(out.frames), total)
+        if cancel and cancel():
+            out.cancelled = len(out.frames) < total
+            break
+    return out
