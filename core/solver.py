@@ -1,9 +1,19 @@
 """Weighted, damped least squares over all views at once, and the pixel weights.
 
-The step solves  (A^T W A + lambda D) delta = -A^T W r  (paper eqs. 6, 31, 34 with damping),
-in Jacobi-scaled unknowns so that radians, pixels and scale mix well; an optional prior pulls
-toward a given offset (the predicted pose) with the same scaling. A normal matrix that is not
-positive definite after damping is reported, never silently inverted.
+Each pixel's residual r (brightness in the new frame minus its template) is scored by the
+negative log-likelihood of a two-component mixture: a Gaussian of scale sigma for pixels that
+move with their segment and a flat density for everything else (background inside a blob,
+occluders, shading changes). Iteratively reweighted least squares on that cost is the EM
+support-map step of paper section 2.4: each row's weight is the posterior that its pixel
+belongs to the body, over sigma^2.
+
+The step solves the Levenberg-Marquardt normal equations (paper eqs. 6, 31, 34 with damping
+and a prior)
+
+.. math:: (A^T W A + \\lambda\\,\\mathrm{diag}(A^T W A) + P)\\,\\delta = -(A^T W r + P o)
+
+where P is a diagonal prior weight pulling the accumulated offset o back toward the predicted
+pose. A normal matrix that is not positive definite is reported, never silently inverted.
 """
 
 from __future__ import annotations
@@ -20,7 +30,7 @@ class DegenerateSystem(RuntimeError):
 
 @dataclass
 class NormalEquations:
-    """Accumulates A^T W A and A^T W r over blocks of rows (views, point sets)."""
+    """Accumulates A^T W A, A^T W r and the robust cost over blocks of rows."""
 
     H: np.ndarray
     b: np.ndarray
@@ -33,44 +43,26 @@ class NormalEquations:
         return cls(np.zeros((n, n)), np.zeros(n))
 
     def add(self, A: np.ndarray, r: np.ndarray, w: np.ndarray) -> None:
-        """Add rows A (N, P), residuals r (N,) and weights w (N,)."""
+        """Add rows A (N, P), residuals r (N,) and IRLS weights w (N,)."""
         Aw = A * w[:, None]
         self.H += Aw.T @ A
         self.b += Aw.T @ r
-        self.cost += float(np.sum(w * r * r))
         self.weight += float(np.sum(w))
         self.rows += len(r)
 
 
-def solve(
-    ne: NormalEquations,
-    damping: float = 1e-3,
-    prior: float = 0.0,
-    offset: np.ndarray | None = None,
-    floor: np.ndarray | None = None,
-) -> np.ndarray:
-    """The damped Gauss-Newton step.
+def mixture_cost(r: np.ndarray, sigma: float, outlier: float) -> np.ndarray:
+    """Per-pixel cost -log(exp(-r^2 / 2 sigma^2) + outlier), shifted to 0 at r = 0.
 
-    With S = diag(1 / sqrt(diag H + floor)), solves (S H S + (damping + prior) I) y =
-    -S b - prior * offset / S and returns delta = S y. ``offset`` is the current parameter
-    offset from the prior's centre; ``floor`` (P,) keeps unobserved unknowns finite.
-    """
-    H, b = ne.H, ne.b
-    P = len(b)
-    if ne.rows == 0 or not np.all(np.isfinite(H)) or not np.all(np.isfinite(b)):
-        raise DegenerateSystem("no usable pixels in any view")
-    d = np.diag(H).copy()
-    d += floor if floor is not None else 1e-9 * max(float(d.max()), 1e-12)
-    S = 1 / np.sqrt(d)
-    Hs = H * S[:, None] * S[None, :] + (damping + prior) * np.eye(P)
-    rhs = -S * b
-    if prior and offset is not None:
-        rhs -= prior * offset / S
-    try:
-        c, low = scipy.linalg.cho_factor(Hs, check_finite=False)
-    except np.linalg.LinAlgError:
-        raise DegenerateSystem("the normal matrix is singular even after damping") from None
-    return S * scipy.linalg.cho_solve((c, low), rhs, check_finite=False)
+    ``outlier`` is the flat density relative to the Gaussian's peak; a pixel that is hidden or
+    off the image costs the full outlier price log((1 + outlier) / outlier)."""
+    return np.log1p(outlier) - np.log(np.exp(-0.5 * (r / sigma) ** 2) + outlier)
+
+
+def support_weights(r: np.ndarray, sigma: float, outlier: float) -> np.ndarray:
+    """IRLS weights of :func:`mixture_cost`: the inlier posterior over sigma^2 (EM E-step)."""
+    g = np.exp(-0.5 * (r / sigma) ** 2)
+    return g / (g + outlier) / sigma**2
 
 
 def robust_scale(r: np.ndarray, floor: float) -> float:
@@ -80,12 +72,44 @@ def robust_scale(r: np.ndarray, floor: float) -> float:
     return max(1.4826 * float(np.median(np.abs(r - np.median(r)))), floor)
 
 
-def support_weights(r: np.ndarray, sigma: float, outlier_density: float = 0.1) -> np.ndarray:
-    """EM posterior that each pixel follows the body's motion (paper section 2.4).
+def solve(
+    ne: NormalEquations,
+    damping: float,
+    prior: np.ndarray | None = None,
+    offset: np.ndarray | None = None,
+    active: np.ndarray | None = None,
+) -> np.ndarray:
+    """The damped Gauss-Newton step for the accumulated normal equations.
 
-    Two-component mixture per pixel: a zero-mean Gaussian of scale sigma for pixels that move
-    with their segment, and a flat density for everything else (background inside the blob,
-    occluders, specularities). ``outlier_density`` is the flat density times sigma*sqrt(2 pi).
+    ``damping`` is Marquardt's lambda (relative to each unknown's own information);
+    ``prior`` (P,) holds diagonal prior weights and ``offset`` (P,) the current offset from the
+    prior's centre; unknowns outside the boolean mask ``active`` (P,) stay put. Raises
+    DegenerateSystem when there are no rows or no finite solution.
     """
-    inlier = np.exp(-0.5 * (r / sigma) ** 2)
-    return inlier / (inlier + outlier_density)
+    if active is not None and not np.all(active):
+        idx = np.flatnonzero(active)
+        sub = NormalEquations(ne.H[np.ix_(idx, idx)], ne.b[idx], ne.cost, ne.weight, ne.rows)
+        step = np.zeros(len(ne.b))
+        step[idx] = solve(sub, damping, None if prior is None else prior[idx],
+                          None if offset is None else offset[idx])
+        return step
+    H, b = ne.H, ne.b
+    P = len(b)
+    if ne.rows == 0 or not np.all(np.isfinite(H)) or not np.all(np.isfinite(b)):
+        raise DegenerateSystem("no usable pixels in any view")
+    d = np.diag(H).copy()
+    scale = max(float(d.max()), 1e-300)
+    pw = np.zeros(P) if prior is None else prior
+    # Jacobi scaling keeps radians, pixels and scale on one footing for the factorisation
+    diag = d * (1 + damping) + pw + 1e-12 * scale
+    S = 1 / np.sqrt(diag)
+    M = (H - np.diag(d)) * S[:, None] * S[None, :] + np.eye(P)
+    rhs = -(b + (pw * offset if offset is not None else 0.0)) * S
+    try:
+        c = scipy.linalg.cho_factor(M, check_finite=False)
+    except np.linalg.LinAlgError:
+        raise DegenerateSystem("the normal matrix is singular even after damping") from None
+    step = S * scipy.linalg.cho_solve(c, rhs, check_finite=False)
+    if not np.all(np.isfinite(step)):
+        raise DegenerateSystem("the step is not finite")
+    return step

@@ -24,7 +24,14 @@ from . import raycast
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from .skeleton import Skeleton
-from .solver import DegenerateSystem, NormalEquations, robust_scale, solve, support_weights
+from .solver import (
+    DegenerateSystem,
+    NormalEquations,
+    mixture_cost,
+    robust_scale,
+    solve,
+    support_weights,
+)
 
 
 @dataclass
@@ -35,13 +42,14 @@ class TrackerSettings:
     iterations: int = 6  # Gauss-Newton iterations per level at most
     pixel_step: int = 1  # use every n-th pixel (both directions) at the finest level
     key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
-    damping: float = 1e-3  # Levenberg-Marquardt damping, relative to each unknown's information
-    prior: float = 1e-3  # pull toward the predicted pose, same scaling
+    damping: float = 1e-2  # initial Levenberg-Marquardt lambda (Marquardt scaling)
+    prior: float = 0.05  # pull toward the predicted pose, relative to each unknown's information
     outlier_density: float = 0.1  # EM support map: flat outlier density (see solver)
     noise_floor: float = 0.01  # smallest residual scale, image units (0..1)
     rim_width: float = 0.3  # blob outline band: weight rises from 0 to 1 across this part
     prediction_gain: float = 1.0  # constant-velocity prediction (0 = hold the last pose)
     converge_pixels: float = 0.05  # stop iterating when no blob moves more (level pixels)
+    min_blob_pixels: float = 2.0  # a joint is solved on levels where its blob is this thick
     divergence_ratio: float = 3.0  # residual over the running median that flags divergence
     min_inside: float = 0.5  # fraction of body pixels that must stay inside the images
     stop_on_divergence: bool = True
@@ -137,6 +145,21 @@ class Tracker:
         self.seq = ImageSequence(images, self.settings.levels)
         self.n_dof = len(skeleton.dof_joints_and_axes()[0])
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
+        # thinnest blob each degree of freedom turns directly, world units (inf: none)
+        dof_joint = skeleton.dof_joints_and_axes()[0]
+        thin = np.full(skeleton.n_joints, np.inf)
+        for b in skeleton.blobs:
+            thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
+        self.dof_thickness = thin[dof_joint]
+
+    def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
+        """Unknowns solved on level ``lv``: the root always; a joint only where its blob is at
+        least ``min_blob_pixels`` thick in the coarsest-scaled view, so that coarse levels do
+        not fling thin limbs they cannot see."""
+        scale = max(v.pose.s for v in pose.views) / 2**lv
+        nr = self.n_params - self.n_dof
+        return np.concatenate([np.ones(nr, bool),
+                               self.dof_thickness * scale >= self.settings.min_blob_pixels])
 
     # --- point sets ---------------------------------------------------------------------
     def _point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
@@ -166,11 +189,18 @@ class Tracker:
         return lab
 
     # --- one level -----------------------------------------------------------------------
-    def _accumulate(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet],
-                    levels: list, labels: list, stats: dict) -> NormalEquations:
+    def _evaluate(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
+                  lv: int, sigmas: list[float] | None, with_rows: bool):
+        """Robust cost of the estimate and, if asked, its normal equations; ``sigmas`` (one per
+        point set) are measured here when None. Returns (per-point costs, NaN where a point is
+        hidden or off the image, normal equations, sigmas, fraction of points inside)."""
         s = self.settings
         ne = NormalEquations.zeros(self.n_params)
-        for ps in sets:
+        costs, n_pts, n_inside = [], 0, 0
+        out_sigmas = []
+        labels = [self._label_map(est, kin, c, levels[c].shape, lv)
+                  for c in range(self.seq.n_views)]
+        for i, ps in enumerate(sets):
             view = est.views[ps.view]
             X = kin.world_points(ps.seg_joint, ps.ref)
             q = view.scaled(X)
@@ -183,28 +213,30 @@ class Tracker:
             visible = np.zeros(len(pix), dtype=bool)
             visible[inb] = lab[p_l[inb, 1], p_l[inb, 0]] == ps.blob[inb]
             ok = inside & visible
-            stats["points"] += len(pix)
-            stats["inside"] += int(inside.sum())
-            if not ok.any():
-                continue
+            n_pts += len(pix)
+            n_inside += int(inside.sum())
             r = vals[ok, 0] - ps.value[ok]
-            sigma = robust_scale(r, s.noise_floor)
-            w = ps.weight[ok] * support_weights(r, sigma, s.outlier_density)
-            A = rows(kin, ps.view, self.mode, ps.seg_joint[ok], q[ok], vals[ok, 1:3])
-            ne.add(A, r, w)
-        return ne
+            sigma = sigmas[i] if sigmas is not None else robust_scale(r, s.noise_floor)
+            out_sigmas.append(sigma)
+            c = np.full(len(pix), np.nan)
+            c[ok] = ps.weight[ok] * mixture_cost(r, sigma, s.outlier_density)
+            costs.append(c)
+            if with_rows and ok.any():
+                w = ps.weight[ok] * support_weights(r, sigma, s.outlier_density)
+                A = rows(kin, ps.view, self.mode, ps.seg_joint[ok], q[ok], vals[ok, 1:3])
+                ne.add(A, r, w)
+        costs = np.concatenate(costs) if costs else np.zeros(0)
+        ne.cost = float(np.nansum(costs))
+        return costs, ne, out_sigmas, (n_inside / n_pts if n_pts else 0.0)
 
     def _blob_pixels(self, pose: BodyPose) -> np.ndarray:
         """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
-        kin_seg = self.skeleton.segment_motions(
+        g = self.skeleton.segment_motions(
             self.skeleton.joint_frames(pose.rotations, pose.root_position)
         )
-        out = []
-        for v in pose.views:
-            pts = [kin_seg[b.joint, :3, :3] @ b.centre + kin_seg[b.joint, :3, 3]
-                   for b in self.skeleton.blobs]
-            out.append(v.project(np.array(pts)))
-        return np.array(out)
+        centres = np.array([g[b.joint, :3, :3] @ b.centre + g[b.joint, :3, 3]
+                            for b in self.skeleton.blobs])
+        return np.array([v.project(centres) for v in pose.views])
 
     def _track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
                      predicted: BodyPose, frame: int) -> FrameResult:
@@ -214,8 +246,7 @@ class Tracker:
         offset = np.zeros(self.n_params)
         total_iters = 0
         converged = False
-        ne = None
-        stats = {"points": 0, "inside": 0}
+        inside = 1.0
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for lv in reversed(range(s.levels)):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
@@ -225,25 +256,39 @@ class Tracker:
                 if s.key_weight > 0 and key_frame != prev_frame:
                     sets.append(self._point_set(key, kin_key, c, key_frame, lv, s.key_weight))
             kin = Kinematics(self.skeleton, est)
-            labels = [self._label_map(est, kin, c, levels[c].shape, lv)
-                      for c in range(self.seq.n_views)]
+            costs, ne, sigmas, inside = self._evaluate(est, kin, sets, levels, lv, None, True)
+            prior = s.prior * np.diag(ne.H)
+            active = self._active(est, lv)
+            lam = s.damping
             converged = False
             for _ in range(s.iterations):
-                stats = {"points": 0, "inside": 0}
-                ne = self._accumulate(est, kin, sets, levels, labels, stats)
-                delta = solve(ne, s.damping, s.prior, offset)
-                before = self._blob_pixels(est)
-                est = apply_update(self.skeleton, est, delta, self.mode)
-                offset += delta
                 total_iters += 1
-                kin = Kinematics(self.skeleton, est)
-                moved = np.max(np.linalg.norm(self._blob_pixels(est) - before, axis=-1))
-                if moved / 2**lv < s.converge_pixels:
-                    converged = True
-                    break
-        residual = float(np.sqrt(ne.cost / max(ne.weight, 1e-12))) if ne else float("nan")
+                delta = solve(ne, lam, prior, offset, active)
+                cand = apply_update(self.skeleton, est, delta, self.mode)
+                kin_c = Kinematics(self.skeleton, cand)
+                c_costs, c_ne, _, c_inside = self._evaluate(
+                    cand, kin_c, sets, levels, lv, sigmas, True)
+                # compare on the pixels seen in both poses: a step must not win by hiding pixels
+                both = ~np.isnan(costs) & ~np.isnan(c_costs)
+                old = float(np.sum(costs[both]) + prior @ offset**2)
+                new = float(np.sum(c_costs[both]) + prior @ (offset + delta) ** 2)
+                if new <= old:
+                    moved = np.max(np.linalg.norm(self._blob_pixels(cand) - self._blob_pixels(est),
+                                                  axis=-1))
+                    est, kin, ne, costs, inside = cand, kin_c, c_ne, c_costs, c_inside
+                    offset = offset + delta
+                    lam = max(lam / 3, 1e-6)
+                    if moved / 2**lv < s.converge_pixels:
+                        converged = True
+                        break
+                else:
+                    lam *= 4
+                    if lam > 1e4:
+                        converged = True  # no step lowers the cost: a minimum at this level
+                        break
+        residual = float(np.sqrt(ne.cost / max(ne.weight * s.noise_floor**2, 1e-12)))
         result = FrameResult(frame, est, residual, total_iters, converged)
-        if stats["points"] and stats["inside"] / stats["points"] < s.min_inside:
+        if inside < s.min_inside:
             result.diverged, result.reason = True, "the body left the image"
         result.seconds = time.perf_counter() - t0
         return result
