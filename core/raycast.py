@@ -93,12 +93,52 @@ def silhouette_box(
 
 
 def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarray, Hits, tuple]:
-    """Cast every ``step``-th pixel of the silhouette box; returns pixels (N, 2), hits, box."""
+    """Z-buffer every ``step``-th pixel of the silhouette box, blob by blob over each blob's own
+    box; returns the covered pixels (N, 2), their hits and the box (None if nothing shows).
+
+    Same result as :func:`cast` on those pixels, at a fraction of the work: under orthography
+    the ray's start is affine in the pixel, so each blob's quadratic is evaluated on its box."""
     box = silhouette_box(view, blobs, g, shape)
     if box is None:
         empty = np.zeros((0, 2))
         return empty, cast(view, empty, blobs, g), None
     x0, y0, x1, y1 = box
-    xs, ys = np.meshgrid(np.arange(x0, x1, step), np.arange(y0, y1, step))
-    pixels = np.stack([xs.ravel(), ys.ravel()], 1).astype(float)
-    return pixels, cast(view, pixels, blobs, g), box
+    xs = np.arange(x0, x1, step, dtype=float)
+    ys = np.arange(y0, y1, step, dtype=float)
+    depth = np.full((len(ys), len(xs)), np.inf)
+    label = np.full(depth.shape, -1)
+    rim = np.zeros(depth.shape)
+    A, C = blob_frames(blobs, g)
+    o00, d = view.ray(np.array([[0.0, 0.0]]))
+    ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
+    oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00[0]
+    for i, b in enumerate(blobs):
+        bb = silhouette_box(view, [b], g, shape, margin=1)
+        if bb is None:
+            continue
+        cx = slice(max(0, -(-(bb[0] - x0) // step)), max(0, -(-(bb[2] - x0) // step)))
+        cy = slice(max(0, -(-(bb[1] - y0) // step)), max(0, -(-(bb[3] - y0) // step)))
+        u, v = xs[cx], ys[cy]
+        if not len(u) or not len(v):
+            continue
+        e = A[i] @ d
+        base = A[i] @ (o00[0] - C[i])
+        yx, yy = A[i] @ ox, A[i] @ oy
+        Y = base + u[None, :, None] * yx + v[:, None, None] * yy  # (h, w, 3)
+        a = e @ e
+        bq = Y @ e
+        cq = np.einsum("hwk,hwk->hw", Y, Y) - 1
+        disc = bq * bq - a * cq
+        hit = disc > 0
+        lam = np.where(hit, (-bq - np.sqrt(np.where(hit, disc, 0))) / a, np.inf)
+        D = depth[cy, cx]
+        nearer = lam < D
+        D[nearer] = lam[nearer]
+        label[cy, cx][nearer] = i
+        rim[cy, cx][nearer] = np.clip(disc[nearer] / a, 0, 1)
+    vv, uu = np.nonzero(label >= 0)
+    pixels = np.stack([xs[uu], ys[vv]], 1)
+    dep = depth[vv, uu]
+    origin = o00[0] + pixels[:, :1] * ox + pixels[:, 1:] * oy
+    hits = Hits(label[vv, uu], dep, origin + dep[:, None] * d, rim[vv, uu])
+    return pixels, hits, box

@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import image as imagelib
-from . import raycast
+from . import raycast, se3
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
-from .skeleton import Skeleton
+from .skeleton import HINGE, Skeleton
 from .solver import (
     DegenerateSystem,
     NormalEquations,
@@ -38,18 +38,20 @@ from .solver import (
 class TrackerSettings:
     """Tracker knobs with their defaults; every field can be set from a job's ``settings``."""
 
-    levels: int = 3  # pyramid levels (1 = full resolution only)
+    levels: int = 4  # pyramid levels (1 = full resolution only)
     iterations: int = 6  # Gauss-Newton iterations per level at most
-    pixel_step: int = 1  # use every n-th pixel (both directions) at the finest level
+    pixel_step: int = 2  # use every n-th pixel (both directions) at the finest level
     key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
     damping: float = 1e-2  # initial Levenberg-Marquardt lambda (Marquardt scaling)
-    prior: float = 0.05  # pull toward the predicted pose, relative to each unknown's information
+    prior: float = 0.0  # pull toward the predicted pose, relative to each unknown's information
     outlier_density: float = 0.1  # EM support map: flat outlier density (see solver)
     noise_floor: float = 0.01  # smallest residual scale, image units (0..1)
     rim_width: float = 0.3  # blob outline band: weight rises from 0 to 1 across this part
     prediction_gain: float = 1.0  # constant-velocity prediction (0 = hold the last pose)
     converge_pixels: float = 0.05  # stop iterating when no blob moves more (level pixels)
     min_blob_pixels: float = 2.0  # a joint is solved on levels where its blob is this thick
+    search: bool = False  # try whole-limb rotations where a joint first becomes solvable
+    search_margin: float = 0.2  # a tried rotation must match this much better to be taken
     divergence_ratio: float = 3.0  # residual over the running median that flags divergence
     min_inside: float = 0.5  # fraction of body pixels that must stay inside the images
     stop_on_divergence: bool = True
@@ -94,6 +96,15 @@ class _PointSet:
     ref: np.ndarray  # (N, 3) reference-frame point
     value: np.ndarray  # (N,) intensity in that frame
     weight: np.ndarray  # (N,) rim weight times the set's weight
+
+
+@dataclass
+class _Samples:
+    """One pose's look at the point sets on one level."""
+
+    costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
+    parts: list  # per set: (indices of usable points, their q, image gradients, residuals)
+    inside: float  # fraction of points inside the images
 
 
 class ImageSequence:
@@ -146,11 +157,16 @@ class Tracker:
         self.n_dof = len(skeleton.dof_joints_and_axes()[0])
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
         # thinnest blob each degree of freedom turns directly, world units (inf: none)
-        dof_joint = skeleton.dof_joints_and_axes()[0]
+        self._dof_joint = skeleton.dof_joints_and_axes()[0]
         thin = np.full(skeleton.n_joints, np.inf)
+        self._bone_direction = np.tile([0.0, 1.0, 0.0], (skeleton.n_joints, 1))
         for b in skeleton.blobs:
-            thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
-        self.dof_thickness = thin[dof_joint]
+            if np.min(b.radii[1:]) < thin[b.joint]:
+                thin[b.joint] = float(np.min(b.radii[1:]))
+                self._bone_direction[b.joint] = b.Q[:, 0]
+        self.dof_thickness = thin[self._dof_joint]
+        moved = skeleton.moved_by()
+        self._subtree = [np.flatnonzero(moved[:, j]) for j in range(skeleton.n_joints)]
 
     def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
         """Unknowns solved on level ``lv``: the root always; a joint only where its blob is at
@@ -189,21 +205,17 @@ class Tracker:
         return lab
 
     # --- one level -----------------------------------------------------------------------
-    def _evaluate(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
-                  lv: int, sigmas: list[float] | None, with_rows: bool):
-        """Robust cost of the estimate and, if asked, its normal equations; ``sigmas`` (one per
-        point set) are measured here when None. Returns (per-point costs, NaN where a point is
-        hidden or off the image, normal equations, sigmas, fraction of points inside)."""
+    def _sample(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
+                lv: int, sigmas: list[float]) -> _Samples:
+        """Map every point set into the new frame under ``est``: per-point robust costs (NaN
+        where the point is hidden by another blob or off the image) and what the rows need."""
         s = self.settings
-        ne = NormalEquations.zeros(self.n_params)
-        costs, n_pts, n_inside = [], 0, 0
-        out_sigmas = []
+        costs, parts, n_pts, n_inside = [], [], 0, 0
         labels = [self._label_map(est, kin, c, levels[c].shape, lv)
                   for c in range(self.seq.n_views)]
-        for i, ps in enumerate(sets):
+        for ps, sigma in zip(sets, sigmas):
             view = est.views[ps.view]
-            X = kin.world_points(ps.seg_joint, ps.ref)
-            q = view.scaled(X)
+            q = view.scaled(kin.world_points(ps.seg_joint, ps.ref))
             pix = q[:, :2] + view.center
             vals, inside = imagelib.sample(levels[ps.view], pix)
             p_l = np.rint(imagelib.to_level(pix, levels[ps.view])).astype(int)
@@ -212,22 +224,92 @@ class Tracker:
             inb = (p_l[:, 0] >= 0) & (p_l[:, 0] < W) & (p_l[:, 1] >= 0) & (p_l[:, 1] < H)
             visible = np.zeros(len(pix), dtype=bool)
             visible[inb] = lab[p_l[inb, 1], p_l[inb, 0]] == ps.blob[inb]
-            ok = inside & visible
+            ok = np.flatnonzero(inside & visible)
             n_pts += len(pix)
             n_inside += int(inside.sum())
             r = vals[ok, 0] - ps.value[ok]
-            sigma = sigmas[i] if sigmas is not None else robust_scale(r, s.noise_floor)
-            out_sigmas.append(sigma)
             c = np.full(len(pix), np.nan)
             c[ok] = ps.weight[ok] * mixture_cost(r, sigma, s.outlier_density)
             costs.append(c)
-            if with_rows and ok.any():
-                w = ps.weight[ok] * support_weights(r, sigma, s.outlier_density)
-                A = rows(kin, ps.view, self.mode, ps.seg_joint[ok], q[ok], vals[ok, 1:3])
-                ne.add(A, r, w)
-        costs = np.concatenate(costs) if costs else np.zeros(0)
-        ne.cost = float(np.nansum(costs))
-        return costs, ne, out_sigmas, (n_inside / n_pts if n_pts else 0.0)
+            parts.append((ok, q[ok], vals[ok, 1:3], r))
+        return _Samples(np.concatenate(costs), parts, n_inside / n_pts if n_pts else 0.0)
+
+    def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
+                          sigmas: list[float]) -> NormalEquations:
+        """Rows of every point set at the sampled pose, weighted by the EM support posterior."""
+        ne = NormalEquations.zeros(self.n_params)
+        for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
+            if len(ok):
+                w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+                ne.add(rows(kin, ps.view, self.mode, ps.seg_joint[ok], q, grad), r, w)
+        ne.cost = float(np.nansum(smp.costs))
+        return ne
+
+    def _sigmas(self, est: BodyPose, kin: Kinematics, sets, levels) -> list[float]:
+        """Residual scale of each point set at the level's starting pose (kept through the
+        level so that costs compare)."""
+        out = []
+        for ps in sets:
+            view = est.views[ps.view]
+            pix = view.project(kin.world_points(ps.seg_joint, ps.ref))
+            vals, inside = imagelib.sample(levels[ps.view], pix)
+            out.append(robust_scale(vals[inside, 0] - ps.value[inside], self.settings.noise_floor))
+        return out
+
+    # --- search for limbs that moved too far for the linear model ---------------------------
+    def _candidates(self, j: int) -> list[np.ndarray]:
+        """Local rotations tried for joint j: hinge angles, or swings of a ball joint's bone."""
+        if self.skeleton.kinds[j] == HINGE:
+            a = np.asarray(self.skeleton.axes[j], float)
+            a = a / np.linalg.norm(a)
+            angles = np.radians([-60, -45, -37.5, -30, -22.5, -15, -7.5, 7.5, 15, 22.5, 30,
+                                 37.5, 45, 60])
+            return [se3.exp_so3(a * t) for t in angles]
+        bone = self._bone_direction[j]
+        e1 = np.cross(bone, np.eye(3)[int(np.argmin(np.abs(bone)))])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(bone, e1)
+        out = []
+        for alpha in np.radians([10, 20, 35, 50]):
+            for phi in np.linspace(0, 2 * np.pi, 8, endpoint=False):
+                out.append(se3.exp_so3(alpha * (np.cos(phi) * e1 + np.sin(phi) * e2)))
+        return out
+
+    def _search(self, est: BodyPose, sets: list[_PointSet], levels: list, sigmas: list[float],
+                joints: list[int]) -> BodyPose:
+        """For each joint (parents first), keep the trial rotation whose subtree's pixels match
+        best: a coarse global step before Gauss-Newton for limbs that moved tens of degrees."""
+        s = self.settings
+        price = float(mixture_cost(np.array([np.inf]), 1.0, s.outlier_density)[0])
+        for j in joints:
+            sub = self._subtree[j]
+            picks = [np.isin(ps.seg_joint, sub) for ps in sets]
+
+            def cost(pose: BodyPose) -> float:
+                g = self.skeleton.segment_motions(
+                    self.skeleton.joint_frames(pose.rotations, pose.root_position))
+                total = 0.0
+                for ps, sigma, pick in zip(sets, sigmas, picks):
+                    if not pick.any():
+                        continue
+                    gj = g[ps.seg_joint[pick]]
+                    X = np.einsum("nab,nb->na", gj[:, :3, :3], ps.ref[pick]) + gj[:, :3, 3]
+                    pix = pose.views[ps.view].project(X)
+                    vals, inside = imagelib.sample(levels[ps.view], pix)
+                    w = ps.weight[pick]
+                    c = mixture_cost(vals[:, 0] - ps.value[pick], sigma, s.outlier_density)
+                    total += float(np.sum(w * np.where(inside, c, price)))
+                return total
+
+            best, best_cost = est, (1 - s.search_margin) * cost(est)
+            for Rc in self._candidates(j):
+                trial = est.copy()
+                trial.rotations[j] = est.rotations[j] @ Rc
+                c = cost(trial)
+                if c < best_cost:
+                    best, best_cost = trial, c
+            est = best
+        return est
 
     def _blob_pixels(self, pose: BodyPose) -> np.ndarray:
         """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
@@ -247,6 +329,8 @@ class Tracker:
         total_iters = 0
         converged = False
         inside = 1.0
+        nr = self.n_params - self.n_dof
+        was_active = np.zeros(self.n_dof, dtype=bool)
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for lv in reversed(range(s.levels)):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
@@ -256,9 +340,18 @@ class Tracker:
                 if s.key_weight > 0 and key_frame != prev_frame:
                     sets.append(self._point_set(key, kin_key, c, key_frame, lv, s.key_weight))
             kin = Kinematics(self.skeleton, est)
-            costs, ne, sigmas, inside = self._evaluate(est, kin, sets, levels, lv, None, True)
-            prior = s.prior * np.diag(ne.H)
+            sigmas = self._sigmas(est, kin, sets, levels)
             active = self._active(est, lv)
+            if s.search:
+                newly = active[nr:] & ~was_active
+                joints = sorted(set(self._dof_joint[newly].tolist()))
+                if joints:
+                    est = self._search(est, sets, levels, sigmas, joints)
+                    kin = Kinematics(self.skeleton, est)
+            was_active = active[nr:]
+            smp = self._sample(est, kin, sets, levels, lv, sigmas)
+            ne = self._normal_equations(kin, sets, smp, sigmas)
+            prior = s.prior * np.diag(ne.H)
             lam = s.damping
             converged = False
             for _ in range(s.iterations):
@@ -266,26 +359,28 @@ class Tracker:
                 delta = solve(ne, lam, prior, offset, active)
                 cand = apply_update(self.skeleton, est, delta, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
-                c_costs, c_ne, _, c_inside = self._evaluate(
-                    cand, kin_c, sets, levels, lv, sigmas, True)
+                c_smp = self._sample(cand, kin_c, sets, levels, lv, sigmas)
                 # compare on the pixels seen in both poses: a step must not win by hiding pixels
-                both = ~np.isnan(costs) & ~np.isnan(c_costs)
-                old = float(np.sum(costs[both]) + prior @ offset**2)
-                new = float(np.sum(c_costs[both]) + prior @ (offset + delta) ** 2)
+                both = ~np.isnan(smp.costs) & ~np.isnan(c_smp.costs)
+                old = float(np.sum(smp.costs[both]) + prior @ offset**2)
+                new = float(np.sum(c_smp.costs[both]) + prior @ (offset + delta) ** 2)
                 if new <= old:
                     moved = np.max(np.linalg.norm(self._blob_pixels(cand) - self._blob_pixels(est),
                                                   axis=-1))
-                    est, kin, ne, costs, inside = cand, kin_c, c_ne, c_costs, c_inside
+                    est, kin, smp = cand, kin_c, c_smp
                     offset = offset + delta
                     lam = max(lam / 3, 1e-6)
-                    if moved / 2**lv < s.converge_pixels:
+                    if moved / 2**lv < s.converge_pixels or old - new < 1e-4 * old:
                         converged = True
                         break
+                    ne = self._normal_equations(kin, sets, smp, sigmas)
                 else:
                     lam *= 4
                     if lam > 1e4:
                         converged = True  # no step lowers the cost: a minimum at this level
                         break
+            inside = smp.inside
+        ne = self._normal_equations(kin, sets, smp, sigmas)
         residual = float(np.sqrt(ne.cost / max(ne.weight * s.noise_floor**2, 1e-12)))
         result = FrameResult(frame, est, residual, total_iters, converged)
         if inside < s.min_inside:
