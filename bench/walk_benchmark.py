@@ -26,34 +26,11 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
-from walk_footage import render  # noqa: E402
+from walk_footage import CAPTURE_FPS, render, write_job  # noqa: E402
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
 
-# The paper's 19 degrees of freedom on the CMU skeleton: ball hips, shoulders and neck; knees
-# and elbows as hinges about the capture's own flexion axes (local frame).
-JOINTS = {
-    "LeftHip": "ball", "RightHip": "ball", "LeftShoulder": "ball", "RightShoulder": "ball",
-    "Neck": "ball",
-    "LeftKnee": {"kind": "hinge", "axis": [0.94, 0.34, 0.0]},
-    "RightKnee": {"kind": "hinge", "axis": [0.94, -0.34, 0.0]},
-    "LeftElbow": {"kind": "hinge", "axis": [0.87, 0.0, -0.5]},
-    "RightElbow": {"kind": "hinge", "axis": [0.87, 0.0, 0.5]},
-}
-# blob short radii a user would set to line the blobs up with this body (metres)
-BLOBS = {
-    "LHipJoint": {"radius": 0.1}, "RHipJoint": {"radius": 0.1},
-    "lowerback": {"radii": [0.12, 0.09]}, "Chest": {"radii": [0.13, 0.09]},
-    "LeftHip": {"radius": 0.075}, "RightHip": {"radius": 0.075},
-    "LeftKnee": {"radius": 0.05}, "RightKnee": {"radius": 0.05},
-    "LeftAnkle": {"radius": 0.04}, "RightAnkle": {"radius": 0.04},
-    "LeftShoulder": {"radius": 0.045}, "RightShoulder": {"radius": 0.045},
-    "LeftElbow": {"radius": 0.037}, "RightElbow": {"radius": 0.037},
-    "Neck": {"radius": 0.05}, "Head": {"radius": 0.085},
-    "LeftCollar": {"radius": 0.06}, "RightCollar": {"radius": 0.06},
-    "LeftToe": False, "RightToe": False, "LeftWrist": False, "RightWrist": False,
-}
 # name: (views, mode, capture frames per video frame: 4 = 30 fps, 8 = 15 fps)
 RUNS = {
     "3 views calibrated 15 fps": (["lateral", "endon", "oblique60"], "calibrated", 8),
@@ -62,26 +39,6 @@ RUNS = {
     "3 views calibrated 30 fps": (["lateral", "endon", "oblique60"], "calibrated", 4),
     "1 lateral view 30 fps": (["lateral"], "calibrated", 4),
 }
-CAPTURE_FPS = 120
-
-
-def write_job(cache: Path, name: str, views, mode: str, step: int, frames: list[int],
-              cameras: dict, settings: dict) -> Path:
-    keep = frames[:: step // 4]
-    jobs = cache / "jobs"
-    jobs.mkdir(exist_ok=True)
-    job = {
-        "skeleton": {"bvh": "../truth.bvh", "joints": JOINTS, "blobs": BLOBS},
-        "initial": {"bvh": "../truth.bvh", "frame": 0},
-        "views": [{"images": [f"../{v}/{f:04d}.png" for f in keep], "camera": cameras[v]}
-                  for v in views],
-        "mode": mode,
-        "settings": settings,
-        "frame_time": step / CAPTURE_FPS,
-    }
-    path = jobs / (name.replace(" ", "_") + ".json")
-    path.write_text(json.dumps(job, indent=1))
-    return path
 
 
 def fmt(x, digits=1):
@@ -107,8 +64,9 @@ def main(argv=None) -> int:
     results, refs = {}, {}
     for name in a.runs.split(","):
         views, mode, step = RUNS[name]
-        job_path = write_job(a.cache, name, views, mode, step, info["frames"], info["cameras"],
-                             settings)
+        job_path = write_job(a.cache, name.replace(" ", "_"), views, mode,
+                             info["frames"][:: step // 4], info["cameras"], settings,
+                             step / CAPTURE_FPS)
         out = job_path.with_suffix(".bvh")
         rep_path = job_path.with_suffix(".report.json")
         cmd = [sys.executable, "-m", "core", "track", str(job_path), "--out", str(out),

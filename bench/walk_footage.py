@@ -2,7 +2,8 @@
 
 The body is *not* the tracker's model: tapered elliptical capsules over the capture's bones,
 skinned to the armature with weights that blend each bone into its parent at the joint, coloured with a
-cloth-like pattern, lit by Workbench's studio light, with sensor noise added. Three orthographic
+cloth-like pattern, lit by Workbench's studio light, in front of a dark backdrop ruled with light lines (as
+Muybridge's were), with sensor noise added. Three orthographic
 views at 480x360 (lateral, end-on at 90 degrees, oblique at 60 degrees) see a fixed stage.
 
 Blender's world is the BVH's world (imported without axis change: y up, metres), so the job's
@@ -34,6 +35,32 @@ WIDTH, HEIGHT = 480, 360
 PIXELS_PER_METRE = 150.0
 STAGE_CENTRE = np.array([0.5, 0.85, -0.55])  # world point at the middle of every image
 NOISE_SIGMA = 2.0  # sensor noise, grey levels of 255
+GRID_PIXELS = 24  # spacing of the backdrop's ruled lines
+CAPTURE_FPS = 120
+
+# The paper's 19 degrees of freedom on the CMU skeleton: ball hips, shoulders and neck; knees
+# and elbows as hinges about the capture's own flexion axes (local frame).
+JOINTS = {
+    "LeftHip": "ball", "RightHip": "ball", "LeftShoulder": "ball", "RightShoulder": "ball",
+    "Neck": "ball",
+    "LeftKnee": {"kind": "hinge", "axis": [0.94, 0.34, 0.0]},
+    "RightKnee": {"kind": "hinge", "axis": [0.94, -0.34, 0.0]},
+    "LeftElbow": {"kind": "hinge", "axis": [0.87, 0.0, -0.5]},
+    "RightElbow": {"kind": "hinge", "axis": [0.87, 0.0, 0.5]},
+}
+# blob short radii a user would set to line the blobs up with this body (metres)
+BLOBS = {
+    "LHipJoint": {"radius": 0.1}, "RHipJoint": {"radius": 0.1},
+    "lowerback": {"radii": [0.12, 0.09]}, "Chest": {"radii": [0.13, 0.09]},
+    "LeftHip": {"radius": 0.075}, "RightHip": {"radius": 0.075},
+    "LeftKnee": {"radius": 0.05}, "RightKnee": {"radius": 0.05},
+    "LeftAnkle": False, "RightAnkle": False,
+    "LeftShoulder": {"radius": 0.045}, "RightShoulder": {"radius": 0.045},
+    "LeftElbow": {"radius": 0.037}, "RightElbow": {"radius": 0.037},
+    "Neck": {"radius": 0.05}, "Head": {"radius": 0.085},
+    "LeftCollar": {"radius": 0.06}, "RightCollar": {"radius": 0.06},
+    "LeftToe": False, "RightToe": False, "LeftWrist": False, "RightWrist": False,
+}
 
 # body radii (metres, across and front to back) by CMU joint name; unnamed joints get DEFAULT_RADIUS
 RADII = {
@@ -51,6 +78,15 @@ RADII = {
 }
 DEFAULT_RADIUS = (0.03, 0.03)
 SKIPPED = ("Fingers", "Thumb", "hand")  # small parts left out of the body
+
+
+def backdrop() -> np.ndarray:
+    """Muybridge's stage: a dark backdrop ruled with light lines every GRID_PIXELS, BGR 0..255
+    (HEIGHT, WIDTH, 3). Static in every view: the tracker must ignore it inside its blobs."""
+    img = np.full((HEIGHT, WIDTH, 3), 22.0)
+    img[GRID_PIXELS // 2 :: GRID_PIXELS, :] = 120.0
+    img[:, GRID_PIXELS // 2 :: GRID_PIXELS] = 120.0
+    return img
 
 
 def camera_rotations() -> dict[str, np.ndarray]:
@@ -189,7 +225,8 @@ def build_scene(bpy, bvh_path: Path):
     scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
-    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.color_mode = "RGBA"
+    scene.render.film_transparent = True  # the backdrop is composited behind the body
     scene.display_settings.display_device = "sRGB"
     scene.view_settings.view_transform = "Standard"
     world = bpy.data.worlds.new("stage")
@@ -223,7 +260,7 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
     out.mkdir(parents=True, exist_ok=True)
     frames = list(range(first, last + 1, step))
     meta = {"bvh": str(CMU_WALK), "frames": frames, "width": WIDTH, "height": HEIGHT,
-            "noise": NOISE_SIGMA, "version": 1}
+            "noise": NOISE_SIGMA, "version": 2}
     stamp = out / "footage.json"
     rots = camera_rotations()
     todo = [(v, f) for v in views for f in frames
@@ -244,7 +281,9 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
             path = out / v / f"{f:04d}.png"
             scene.render.filepath = str(path)
             bpy.ops.render.render(write_still=True)
-            img = cv2.imread(str(path)).astype(np.float32)
+            rgba = cv2.imread(str(path), cv2.IMREAD_UNCHANGED).astype(np.float32)
+            alpha = rgba[..., 3:] / 255
+            img = rgba[..., :3] * alpha + backdrop() * (1 - alpha)
             img += rng.normal(0, NOISE_SIGMA, img.shape)
             cv2.imwrite(str(path), np.clip(img + 0.5, 0, 255).astype(np.uint8))
     stamp.write_text(json.dumps(meta, indent=1))
@@ -255,6 +294,27 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
     cams_json = {v: job_camera(rots[v]) for v in views}
     (out / "cameras.json").write_text(json.dumps(cams_json, indent=1))
     return {"frames": frames, "cameras": cams_json, "rendered": len(todo)}
+
+
+def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list[int],
+              cameras: dict, settings: dict, frame_time: float) -> Path:
+    """Write folder/jobs/<name>.json tracking the given rendered frames (capture indices) of
+    the given views; the skeleton and initial pose come from folder/truth.bvh's first frame,
+    which must be the first of ``frames``."""
+    jobs = folder / "jobs"
+    jobs.mkdir(exist_ok=True)
+    job = {
+        "skeleton": {"bvh": "../truth.bvh", "joints": JOINTS, "blobs": BLOBS},
+        "initial": {"bvh": "../truth.bvh", "frame": 0},
+        "views": [{"images": [f"../{v}/{f:04d}.png" for f in frames], "camera": cameras[v]}
+                  for v in views],
+        "mode": mode,
+        "settings": settings,
+        "frame_time": frame_time,
+    }
+    path = jobs / f"{name}.json"
+    path.write_text(json.dumps(job, indent=1))
+    return path
 
 
 def main(argv=None) -> int:

@@ -54,13 +54,17 @@ class Level:
         return self.stack.shape[:2]
 
 
-def pyramid(img: np.ndarray, levels: int, blur: float = 0.8) -> list[Level]:
+def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0.0) -> list[Level]:
     """Gaussian pyramid with derivatives, finest level first; each level lightly pre-smoothed
-    (sigma ``blur`` level pixels) so that gradients see past the sensor noise."""
+    (sigma ``blur`` level pixels) so that gradients see past the sensor noise, and, when
+    ``highpass`` > 0, stripped of its local mean over that sigma (level pixels) so that slow
+    shading changes across a turning limb do not read as motion."""
     out = []
     cur = img
     for lv in range(levels):
         sm = cv2.GaussianBlur(cur, (0, 0), blur) if blur > 0 else cur
+        if highpass > 0:
+            sm = sm - cv2.GaussianBlur(sm, (0, 0), highpass)
         gx = cv2.Sobel(sm, cv2.CV_32F, 1, 0, ksize=3, scale=1 / 8)
         gy = cv2.Sobel(sm, cv2.CV_32F, 0, 1, ksize=3, scale=1 / 8)
         out.append(Level(np.dstack([sm, gx, gy]), float(2**lv)))

@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import image as imagelib
-from . import raycast, se3
+from . import raycast
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
-from .skeleton import HINGE, Skeleton
+from .skeleton import Skeleton
 from .solver import (
     DegenerateSystem,
     NormalEquations,
@@ -39,6 +39,7 @@ class TrackerSettings:
     """Tracker knobs with their defaults; every field can be set from a job's ``settings``."""
 
     levels: int = 4  # pyramid levels (1 = full resolution only)
+    highpass: float = 4.0  # remove shading: subtract the local mean over this sigma (level px)
     iterations: int = 6  # Gauss-Newton iterations per level at most
     pixel_step: int = 2  # use every n-th pixel (both directions) at the finest level
     key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
@@ -49,9 +50,7 @@ class TrackerSettings:
     rim_width: float = 0.3  # blob outline band: weight rises from 0 to 1 across this part
     prediction_gain: float = 1.0  # constant-velocity prediction (0 = hold the last pose)
     converge_pixels: float = 0.05  # stop iterating when no blob moves more (level pixels)
-    min_blob_pixels: float = 2.0  # a joint is solved on levels where its blob is this thick
-    search: bool = False  # try whole-limb rotations where a joint first becomes solvable
-    search_margin: float = 0.2  # a tried rotation must match this much better to be taken
+    min_blob_pixels: float = 1.0  # a joint is solved on levels where its blob is this thick
     divergence_ratio: float = 3.0  # residual over the running median that flags divergence
     min_inside: float = 0.5  # fraction of body pixels that must stay inside the images
     stop_on_divergence: bool = True
@@ -110,9 +109,10 @@ class _Samples:
 class ImageSequence:
     """Frames of every view, read on demand: ``images[view][frame]`` is a path or an array."""
 
-    def __init__(self, images: Sequence[Sequence], levels: int):
+    def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0):
         self.images = images
         self.levels = levels
+        self.highpass = highpass
         self._cache: dict[tuple[int, int], list[imagelib.Level]] = {}
 
     @property
@@ -127,7 +127,7 @@ class ImageSequence:
         if key not in self._cache:
             src = self.images[view][frame]
             img = imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
-            self._cache[key] = imagelib.pyramid(img, self.levels)
+            self._cache[key] = imagelib.pyramid(img, self.levels, highpass=self.highpass)
         return self._cache[key]
 
     def keep_only(self, keys: set[tuple[int, int]]) -> None:
@@ -153,20 +153,14 @@ class Tracker:
         self.skeleton = skeleton
         self.mode = mode
         self.settings = settings or TrackerSettings()
-        self.seq = ImageSequence(images, self.settings.levels)
+        self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
         self.n_dof = len(skeleton.dof_joints_and_axes()[0])
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
         # thinnest blob each degree of freedom turns directly, world units (inf: none)
-        self._dof_joint = skeleton.dof_joints_and_axes()[0]
         thin = np.full(skeleton.n_joints, np.inf)
-        self._bone_direction = np.tile([0.0, 1.0, 0.0], (skeleton.n_joints, 1))
         for b in skeleton.blobs:
-            if np.min(b.radii[1:]) < thin[b.joint]:
-                thin[b.joint] = float(np.min(b.radii[1:]))
-                self._bone_direction[b.joint] = b.Q[:, 0]
-        self.dof_thickness = thin[self._dof_joint]
-        moved = skeleton.moved_by()
-        self._subtree = [np.flatnonzero(moved[:, j]) for j in range(skeleton.n_joints)]
+            thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
+        self.dof_thickness = thin[skeleton.dof_joints_and_axes()[0]]
 
     def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
         """Unknowns solved on level ``lv``: the root always; a joint only where its blob is at
@@ -256,61 +250,6 @@ class Tracker:
             out.append(robust_scale(vals[inside, 0] - ps.value[inside], self.settings.noise_floor))
         return out
 
-    # --- search for limbs that moved too far for the linear model ---------------------------
-    def _candidates(self, j: int) -> list[np.ndarray]:
-        """Local rotations tried for joint j: hinge angles, or swings of a ball joint's bone."""
-        if self.skeleton.kinds[j] == HINGE:
-            a = np.asarray(self.skeleton.axes[j], float)
-            a = a / np.linalg.norm(a)
-            angles = np.radians([-60, -45, -37.5, -30, -22.5, -15, -7.5, 7.5, 15, 22.5, 30,
-                                 37.5, 45, 60])
-            return [se3.exp_so3(a * t) for t in angles]
-        bone = self._bone_direction[j]
-        e1 = np.cross(bone, np.eye(3)[int(np.argmin(np.abs(bone)))])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(bone, e1)
-        out = []
-        for alpha in np.radians([10, 20, 35, 50]):
-            for phi in np.linspace(0, 2 * np.pi, 8, endpoint=False):
-                out.append(se3.exp_so3(alpha * (np.cos(phi) * e1 + np.sin(phi) * e2)))
-        return out
-
-    def _search(self, est: BodyPose, sets: list[_PointSet], levels: list, sigmas: list[float],
-                joints: list[int]) -> BodyPose:
-        """For each joint (parents first), keep the trial rotation whose subtree's pixels match
-        best: a coarse global step before Gauss-Newton for limbs that moved tens of degrees."""
-        s = self.settings
-        price = float(mixture_cost(np.array([np.inf]), 1.0, s.outlier_density)[0])
-        for j in joints:
-            sub = self._subtree[j]
-            picks = [np.isin(ps.seg_joint, sub) for ps in sets]
-
-            def cost(pose: BodyPose) -> float:
-                g = self.skeleton.segment_motions(
-                    self.skeleton.joint_frames(pose.rotations, pose.root_position))
-                total = 0.0
-                for ps, sigma, pick in zip(sets, sigmas, picks):
-                    if not pick.any():
-                        continue
-                    gj = g[ps.seg_joint[pick]]
-                    X = np.einsum("nab,nb->na", gj[:, :3, :3], ps.ref[pick]) + gj[:, :3, 3]
-                    pix = pose.views[ps.view].project(X)
-                    vals, inside = imagelib.sample(levels[ps.view], pix)
-                    w = ps.weight[pick]
-                    c = mixture_cost(vals[:, 0] - ps.value[pick], sigma, s.outlier_density)
-                    total += float(np.sum(w * np.where(inside, c, price)))
-                return total
-
-            best, best_cost = est, (1 - s.search_margin) * cost(est)
-            for Rc in self._candidates(j):
-                trial = est.copy()
-                trial.rotations[j] = est.rotations[j] @ Rc
-                c = cost(trial)
-                if c < best_cost:
-                    best, best_cost = trial, c
-            est = best
-        return est
-
     def _blob_pixels(self, pose: BodyPose) -> np.ndarray:
         """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
         g = self.skeleton.segment_motions(
@@ -329,8 +268,6 @@ class Tracker:
         total_iters = 0
         converged = False
         inside = 1.0
-        nr = self.n_params - self.n_dof
-        was_active = np.zeros(self.n_dof, dtype=bool)
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for lv in reversed(range(s.levels)):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
@@ -342,13 +279,6 @@ class Tracker:
             kin = Kinematics(self.skeleton, est)
             sigmas = self._sigmas(est, kin, sets, levels)
             active = self._active(est, lv)
-            if s.search:
-                newly = active[nr:] & ~was_active
-                joints = sorted(set(self._dof_joint[newly].tolist()))
-                if joints:
-                    est = self._search(est, sets, levels, sigmas, joints)
-                    kin = Kinematics(self.skeleton, est)
-            was_active = active[nr:]
             smp = self._sample(est, kin, sets, levels, lv, sigmas)
             ne = self._normal_equations(kin, sets, smp, sigmas)
             prior = s.prior * np.diag(ne.H)

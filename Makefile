@@ -1,0 +1,32 @@
+# twist-mocap: the two commands a newcomer runs are `make demo` and `make test`.
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+
+.PHONY: venv demo test lint bench clean
+
+venv: $(STAMP)
+
+$(STAMP): requirements.txt
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -r requirements.txt
+	touch $(STAMP)
+
+# Track the bundled example (rendered walk, three views) from the command line.
+demo: venv
+	$(PY) bench/demo.py
+
+test: venv
+	$(PY) -m pytest
+
+lint: venv
+	$(VENV)/bin/ruff check core bench tests
+
+# The tracking benchmark (renders its footage once into .cache/, ~10 minutes).
+bench: venv
+	$(PY) bench/walk_benchmark.py
+
+clean:
+	rm -rf .cache dist .pytest_cache
