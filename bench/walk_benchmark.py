@@ -19,14 +19,13 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
-from walk_footage import CAPTURE_FPS, render, write_job  # noqa: E402
+from walk_footage import CAPTURE_FPS, JOINTS, render, write_job  # noqa: E402
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
