@@ -43,7 +43,8 @@ class View:
         return View(self.pose.copy(), np.array(self.center, dtype=float))
 
     def at_level(self, level: int) -> "View":
-        """The same camera on pyramid level ``level`` (pixels shrunk by 2**level)."""
+        """The same camera on pyramid level ``level``: pixel p of the full image is pixel
+        p / 2**level there (see core.image)."""
         f = 0.5**level
         pose = Similarity(self.pose.s * f, self.pose.R, self.pose.t)
-        return View(pose, (np.asarray(self.center) + 0.5) * f - 0.5)
+        return View(pose, np.asarray(self.center) * f)

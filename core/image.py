@@ -2,7 +2,9 @@
 
 Images are float32 arrays (height, width) with values in [0, 1]; pixel (x, y) is column x,
 row y, with integer coordinates at pixel centres. Level l of a pyramid halves the size l
-times: full-resolution pixel p sits at (p + 0.5) / 2**l - 0.5 on level l.
+times with ``cv2.pyrDown``, whose pixel i is centred on pixel 2i of the level below: full-
+resolution pixel p sits at p / 2**l on level l. Bilinear sampling goes through ``cv2.remap``,
+which rounds sample positions to 1/32 pixel.
 """
 
 from __future__ import annotations
@@ -75,7 +77,7 @@ def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0
 
 def to_level(pixels: np.ndarray, level: Level) -> np.ndarray:
     """Full-resolution pixel coordinates (..., 2) to the level's coordinates."""
-    return (pixels + 0.5) / level.scale - 0.5
+    return pixels / level.scale
 
 
 def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -85,7 +85,7 @@ def log_so3(R: np.ndarray) -> np.ndarray:
     # Near pi: R = I + 2 a a^T - ... ; recover the axis from the symmetric part.
     S = (R + R.T) / 2 - cos_t * np.eye(3)  # = (1 - cos t) a a^T
     k = int(np.argmax(np.diag(S)))
-    a = S[:, k] / np.sqrt(S[k, k])
+    a = S[:, k] / np.linalg.norm(S[:, k])
     if axis_sin @ a < 0:
         a = -a
     return a * theta

@@ -1,0 +1,58 @@
+"""Pyramids, derivatives and bilinear sampling on images with known values."""
+
+import cv2
+import numpy as np
+import pytest
+
+from core import image
+
+
+def test_sampling_is_exact_at_pixels_and_linear_between():
+    rng = np.random.default_rng(0)
+    img = rng.uniform(size=(50, 70)).astype(np.float32)
+    lv = image.Level(np.dstack([img, img, img]), 1.0)
+    ys, xs = np.mgrid[1:49, 1:69]
+    pts = np.stack([xs.ravel(), ys.ravel()], 1).astype(float)
+    vals, inside = image.sample(lv, pts)
+    assert inside.all()
+    np.testing.assert_allclose(vals[:, 0], img[ys.ravel(), xs.ravel()], atol=1e-6)
+    mid, _ = image.sample(lv, np.array([[10.25, 20.5]]))
+    expect = (0.75 * (img[20, 10] + img[21, 10]) + 0.25 * (img[20, 11] + img[21, 11])) / 2
+    assert mid[0, 0] == pytest.approx(expect, abs=1e-5)
+
+
+def test_more_points_than_remap_accepts_in_one_row():
+    img = np.tile(np.arange(40, dtype=np.float32), (30, 1))
+    lv = image.Level(np.dstack([img, img, img]), 1.0)
+    pts = np.random.default_rng(1).uniform([0, 0], [39, 29], size=(70000, 2))
+    vals, _ = image.sample(lv, pts)
+    np.testing.assert_allclose(vals[:, 0], pts[:, 0], atol=1 / 64 + 1e-4)  # remap's 1/32 px grid
+
+
+def test_pyramid_derivatives_of_a_ramp_are_its_slope_per_full_pixel():
+    H, W = 128, 160
+    xs = np.arange(W, dtype=np.float32)
+    img = np.tile(0.2 + 0.003 * xs, (H, 1)) + 0.002 * np.arange(H, dtype=np.float32)[:, None]
+    levels = image.pyramid(img, 3)
+    for lv in levels:
+        pts = np.array([[60.0, 50.0], [80.3, 70.7]])
+        vals, inside = image.sample(lv, pts)
+        assert inside.all()
+        np.testing.assert_allclose(vals[:, 1], 0.003, rtol=0.02)
+        np.testing.assert_allclose(vals[:, 2], 0.002, rtol=0.02)
+        np.testing.assert_allclose(vals[:, 0], 0.2 + 0.003 * pts[:, 0] + 0.002 * pts[:, 1],
+                                   atol=2e-4)
+
+
+def test_points_outside_are_flagged():
+    lv = image.pyramid(np.zeros((20, 30), np.float32), 2)[1]
+    _, inside = image.sample(lv, np.array([[-3.0, 5.0], [10.0, 10.0], [29.9, 19.0]]))
+    assert inside.tolist() == [False, True, False]
+
+
+def test_load_grey_reads_files_and_names_bad_ones(tmp_path):
+    path = tmp_path / "a.png"
+    cv2.imwrite(str(path), np.full((4, 5, 3), 255, np.uint8))
+    np.testing.assert_allclose(image.load_grey(path), 1.0)
+    with pytest.raises(image.ImageError, match="missing.png"):
+        image.load_grey(tmp_path / "missing.png")

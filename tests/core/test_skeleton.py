@@ -1,0 +1,86 @@
+"""Forward kinematics against the product of exponentials built from twists (paper eq. 23)."""
+
+import numpy as np
+import pytest
+
+from core import se3
+from core.bvh import read_bvh
+from core.skeleton import (
+    BALL,
+    HINGE,
+    human_template,
+    planar_chain_template,
+    skeleton_from_bvh,
+    walker_template,
+)
+
+
+def test_segment_motions_are_the_product_of_exponentials(cmu_walk):
+    b = read_bvh(cmu_walk)
+    sk = skeleton_from_bvh(b)
+    R, root = b.frame_pose(500)
+    g = sk.segment_motions(sk.joint_frames(R, root))
+    p = sk.rest_positions
+    G0 = se3.rigid(R[0], root) @ se3.rigid(np.eye(3), -p[0])
+    for k in [sk.index("LeftToe"), sk.index("RThumb"), sk.index("Head")]:
+        chain = sk.ancestors(k)[::-1][1:]  # root excluded, root first
+        expect = G0.copy()
+        for j in chain:
+            w = se3.log_so3(R[j])
+            theta = np.linalg.norm(w)
+            xi = se3.twist_of_axis(w / theta, p[j]) if theta > 0 else np.zeros(6)
+            expect = expect @ se3.exp_se3(xi * theta)
+        np.testing.assert_allclose(g[k], expect, atol=1e-10)
+
+
+def test_world_positions_follow_offsets_at_rest(cmu_walk):
+    sk = skeleton_from_bvh(read_bvh(cmu_walk))
+    J = sk.n_joints
+    X = sk.world_positions(np.tile(np.eye(3), (J, 1, 1)), np.array([1.0, 2.0, 3.0]))
+    np.testing.assert_allclose(X - X[0], sk.rest_positions - sk.rest_positions[0], atol=1e-12)
+    np.testing.assert_allclose(X[0], [1, 2, 3])
+
+
+def test_templates_have_the_named_degrees_of_freedom():
+    human = human_template()
+    assert len(human.dof_names()) == 19
+    assert {human.names[j] for j, k in enumerate(human.kinds) if k == BALL} == {
+        "Neck", "LeftShoulder", "RightShoulder", "LeftHip", "RightHip"}
+    assert {human.names[j] for j, k in enumerate(human.kinds) if k == HINGE} == {
+        "LeftElbow", "RightElbow", "LeftKnee", "RightKnee"}
+    walker = walker_template()
+    assert len(walker.dof_names()) == 6
+    chain = planar_chain_template(axis=(0, 0, 1))
+    _, axes = chain.dof_joints_and_axes()
+    np.testing.assert_allclose(axes, np.tile([0, 0, 1.0], (len(axes), 1)))
+    for sk in (human, walker, chain):
+        assert sk.blobs and all(np.all(b.radii > 0) for b in sk.blobs)
+
+
+def test_a_planar_chain_stays_in_its_plane():
+    chain = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
+    R = np.tile(np.eye(3), (chain.n_joints, 1, 1))
+    for j, a in zip(*chain.dof_joints_and_axes()):
+        R[j] = se3.exp_so3(a * 0.7)
+    X = chain.world_positions(R, np.zeros(3))
+    np.testing.assert_allclose(X[:, 2], 0, atol=1e-12)
+    lengths = np.linalg.norm(np.diff(X[1:], axis=0), axis=1)
+    np.testing.assert_allclose(lengths, [0.5, 0.4])
+
+
+def test_default_blobs_span_their_bones():
+    sk = human_template()
+    b = next(b for b in sk.blobs if b.name == "LeftKnee")
+    knee = sk.rest_positions[sk.index("LeftKnee")]
+    tip = knee + sk.end_sites[sk.index("LeftKnee")][0]
+    np.testing.assert_allclose(b.centre, (knee + tip) / 2)
+    assert b.radii[0] == pytest.approx(np.linalg.norm(tip - knee) / 2)
+    np.testing.assert_allclose(np.abs(b.Q[:, 0]), [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(b.Q.T @ b.Q, np.eye(3), atol=1e-12)
+
+
+def test_parents_must_precede_children():
+    from core.skeleton import Skeleton
+
+    with pytest.raises(ValueError, match="parents must come before"):
+        Skeleton(names=["a", "b"], parents=[-1, 1], offsets=np.zeros((2, 3)))
