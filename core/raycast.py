@@ -68,28 +68,26 @@ def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid], g: np.ndarray) 
     return Hits(label, depth, world, np.clip(rim, 0.0, 1.0))
 
 
-def silhouette_box(
-    view: View, blobs: list[Ellipsoid], g: np.ndarray, shape: tuple[int, int], margin: int = 2
-):
-    """Integer pixel box (x0, y0, x1, y1), end-exclusive and clipped to the image ``shape``
-    (height, width), that holds every blob's outline; None when nothing is in the image."""
-    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
-    for b in blobs:
-        R, p = g[b.joint, :3, :3], g[b.joint, :3, 3]
-        centre = view.project(R @ b.centre + p)
-        # extent of an ellipsoid along image axis i: s * |diag(r) (R_cam R Q)^T e_i|
-        M = view.pose.s * (view.pose.R @ R @ b.Q) * b.radii
-        half = np.linalg.norm(M[:2], axis=1)
-        lo = np.minimum(lo, centre - half)
-        hi = np.maximum(hi, centre + half)
-    if not np.all(np.isfinite(lo)):
-        return None
+def blob_boxes(view: View, blobs: list[Ellipsoid], g: np.ndarray) -> np.ndarray:
+    """Pixel extents (E, 4) = (xmin, ymin, xmax, ymax) of every blob's outline, as floats.
+
+    An ellipsoid's half extent along image axis i is |row i of s R_cam R_seg Q diag(r)|."""
+    joints = np.array([b.joint for b in blobs], dtype=int)
+    Rs, ps = g[joints, :3, :3], g[joints, :3, 3]
+    centres = np.einsum("eab,eb->ea", Rs, np.array([b.centre for b in blobs])) + ps
+    axes = np.einsum("eab,ebc->eac", Rs, np.array([b.Q for b in blobs]))
+    axes = axes * np.array([b.radii for b in blobs])[:, None, :]
+    M = view.pose.s * np.einsum("ab,ebc->eac", view.pose.R[:2], axes)
+    half = np.linalg.norm(M, axis=2)
+    c = view.project(centres)
+    return np.concatenate([c - half, c + half], 1)
+
+
+def _clip_box(lo, hi, shape, margin: int):
     H, W = shape
     x0, y0 = max(int(np.floor(lo[0])) - margin, 0), max(int(np.floor(lo[1])) - margin, 0)
     x1, y1 = min(int(np.ceil(hi[0])) + margin + 1, W), min(int(np.ceil(hi[1])) + margin + 1, H)
-    if x0 >= x1 or y0 >= y1:
-        return None
-    return x0, y0, x1, y1
+    return None if x0 >= x1 or y0 >= y1 else (x0, y0, x1, y1)
 
 
 def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarray, Hits, tuple]:
@@ -98,7 +96,8 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
 
     Same result as :func:`cast` on those pixels, at a fraction of the work: under orthography
     the ray's start is affine in the pixel, so each blob's quadratic is evaluated on its box."""
-    box = silhouette_box(view, blobs, g, shape)
+    boxes = blob_boxes(view, blobs, g) if blobs else np.zeros((0, 4))
+    box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if blobs else None
     if box is None:
         empty = np.zeros((0, 2))
         return empty, cast(view, empty, blobs, g), None
@@ -113,7 +112,7 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
     oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00[0]
     for i, b in enumerate(blobs):
-        bb = silhouette_box(view, [b], g, shape, margin=1)
+        bb = _clip_box(boxes[i, :2], boxes[i, 2:], shape, 1)
         if bb is None:
             continue
         cx = slice(max(0, -(-(bb[0] - x0) // step)), max(0, -(-(bb[2] - x0) // step)))

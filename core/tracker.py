@@ -38,9 +38,9 @@ from .solver import (
 class TrackerSettings:
     """Tracker knobs with their defaults; every field can be set from a job's ``settings``."""
 
-    levels: int = 4  # pyramid levels (1 = full resolution only)
+    levels: int = 3  # pyramid levels (1 = full resolution only)
     highpass: float = 4.0  # remove shading: subtract the local mean over this sigma (level px)
-    iterations: int = 6  # Gauss-Newton iterations per level at most
+    iterations: int = 5  # Gauss-Newton iterations per level at most
     pixel_step: int = 2  # use every n-th pixel (both directions) at the finest level
     key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
     damping: float = 1e-2  # initial Levenberg-Marquardt lambda (Marquardt scaling)
@@ -49,7 +49,7 @@ class TrackerSettings:
     noise_floor: float = 0.01  # smallest residual scale, image units (0..1)
     rim_width: float = 0.3  # blob outline band: weight rises from 0 to 1 across this part
     prediction_gain: float = 1.0  # constant-velocity prediction (0 = hold the last pose)
-    converge_pixels: float = 0.05  # stop iterating when no blob moves more (level pixels)
+    converge_pixels: float = 0.2  # stop iterating when no blob moves more (level pixels)
     min_blob_pixels: float = 1.0  # a joint is solved on levels where its blob is this thick
     divergence_ratio: float = 3.0  # residual over the running median that flags divergence
     min_inside: float = 0.5  # fraction of body pixels that must stay inside the images
@@ -154,6 +154,7 @@ class Tracker:
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
+        self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
         self.n_dof = len(skeleton.dof_joints_and_axes()[0])
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
         # thinnest blob each degree of freedom turns directly, world units (inf: none)
@@ -275,7 +276,11 @@ class Tracker:
             for c in range(self.seq.n_views):
                 sets.append(self._point_set(prev, kin_prev, c, prev_frame, lv, 1.0))
                 if s.key_weight > 0 and key_frame != prev_frame:
-                    sets.append(self._point_set(key, kin_key, c, key_frame, lv, s.key_weight))
+                    k = (key_frame, c, lv)
+                    if k not in self._key_sets:
+                        self._key_sets[k] = self._point_set(key, kin_key, c, key_frame, lv,
+                                                            s.key_weight)
+                    sets.append(self._key_sets[k])
             kin = Kinematics(self.skeleton, est)
             sigmas = self._sigmas(est, kin, sets, levels)
             active = self._active(est, lv)
@@ -333,6 +338,7 @@ class Tracker:
                 f"the pose has {len(initial.views)} views, the footage {self.seq.n_views}"
             )
         key_frame = frames[0]
+        self._key_sets.clear()  # the key pose may differ from an earlier run's
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
         yield first
         history = [first]
