@@ -70,7 +70,8 @@ def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
     local = {}
     for n in tracked_joints:
         j = sk.index(n)
-        local[n] = float(np.degrees(se3.rotation_angle_between(est[0][:, j], truth[0][:, j])).mean())
+        angle = se3.rotation_angle_between(est[0][:, j], truth[0][:, j])
+        local[n] = float(np.degrees(angle).mean())
     per_frame = np.mean([per[k] for k in HEADLINE], axis=0)
     return Scores({k: float(v.mean()) for k, v in per.items()}, float(per_frame.mean()),
                   float(np.linalg.norm(rel, axis=-1).mean() * unit_mm), local, per_frame)

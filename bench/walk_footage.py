@@ -1,10 +1,11 @@
 """Render Muybridge-style footage of the CMU walk with Blender, and write tracking jobs for it.
 
 The body is *not* the tracker's model: tapered elliptical capsules over the capture's bones,
-skinned to the armature with weights that blend each bone into its parent at the joint, coloured with a
-cloth-like pattern, lit by Workbench's studio light, in front of a dark backdrop ruled with light lines (as
-Muybridge's were), with sensor noise added. Three orthographic
-views at 480x360 (lateral, end-on at 90 degrees, oblique at 60 degrees) see a fixed stage.
+skinned to the armature with weights that blend each bone into its parent at the joint,
+coloured with a cloth-like pattern, lit by Workbench's studio light, in front of a dark
+backdrop ruled with light lines (as Muybridge's were), with sensor noise added. Three
+orthographic views at 480x360 (lateral, end-on at 90 degrees, oblique at 60 degrees) see a
+fixed stage.
 
 Blender's world is the BVH's world (imported without axis change: y up, metres), so the job's
 cameras and the ground truth need no conversion. Run with the project's virtual environment:
@@ -62,7 +63,7 @@ BLOBS = {
     "LeftToe": False, "RightToe": False, "LeftWrist": False, "RightWrist": False,
 }
 
-# body radii (metres, across and front to back) by CMU joint name; unnamed joints get DEFAULT_RADIUS
+# body radii (metres, across and front to back) by CMU joint name; others get DEFAULT_RADIUS
 RADII = {
     "Hips": (0.12, 0.10), "LHipJoint": (0.11, 0.09), "RHipJoint": (0.11, 0.09),
     "LeftHip": (0.085, 0.085), "RightHip": (0.085, 0.085),
@@ -124,7 +125,8 @@ def cloth_colour(P: np.ndarray, seed: int = 7) -> np.ndarray:
     stripes = 0.5 + 0.5 * np.sign(np.sin(P[:, 1] * 2 * np.pi / 0.07)) * np.sign(
         np.sin((P[:, 0] + P[:, 2]) * 2 * np.pi / 0.09))
     k = rng.normal(size=(10, 3))
-    k *= 2 * np.pi / 0.05 / np.linalg.norm(k, axis=1, keepdims=True) * rng.uniform(0.6, 1.6, (10, 1))
+    k *= 2 * np.pi / 0.05 / np.linalg.norm(k, axis=1, keepdims=True)
+    k *= rng.uniform(0.6, 1.6, (10, 1))
     blotch = np.sin(P @ k.T + rng.uniform(0, 6.3, 10)).mean(1)
     base = np.array([0.45, 0.28, 0.2]) + 0.4 * stripes[:, None] * np.array([0.6, 0.9, 1.0])
     return np.clip(base + 0.6 * blotch[:, None], 0.02, 0.98)

@@ -83,7 +83,7 @@ class BvhFile:
                         root[:, _POS.index(c)] = vals[:, i]
         return R, root
 
-    def with_motion(self, rotations: np.ndarray, root_positions: np.ndarray) -> "BvhFile":
+    def with_motion(self, rotations: np.ndarray, root_positions: np.ndarray) -> BvhFile:
         """A copy with the same hierarchy and channel layout holding the given poses.
 
         rotations: (F, J, 3, 3) local rotations; root_positions: (F, 3).

@@ -39,10 +39,10 @@ class View:
         origin = (q - self.pose.t) @ self.pose.R
         return origin, self.pose.R[2].copy()
 
-    def copy(self) -> "View":
+    def copy(self) -> View:
         return View(self.pose.copy(), np.array(self.center, dtype=float))
 
-    def at_level(self, level: int) -> "View":
+    def at_level(self, level: int) -> View:
         """The same camera on pyramid level ``level``: pixel p of the full image is pixel
         p / 2**level there (see core.image)."""
         f = 0.5**level

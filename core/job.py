@@ -118,7 +118,8 @@ def _apply_joints(sk: Skeleton, spec, where: str) -> None:
         raise JobError(f"{where}: expected an object naming the tracked joints")
     for name, js in spec.items():
         if name not in sk.names:
-            raise JobError(f"{where}.{name}: no such joint in the BVH; it has {', '.join(sk.names)}")
+            raise JobError(
+                f"{where}.{name}: no such joint in the BVH; it has {', '.join(sk.names)}")
         j = sk.names.index(name)
         kind = js if isinstance(js, str) else js.get("kind") if isinstance(js, dict) else None
         if kind not in (BALL, HINGE, FIXED):
@@ -130,7 +131,8 @@ def _apply_joints(sk: Skeleton, spec, where: str) -> None:
         sk.kinds[j] = kind
         if kind == HINGE:
             if not isinstance(js, dict) or "axis" not in js:
-                raise JobError(f"{where}.{name}: a hinge needs an 'axis' in the joint's local frame")
+                raise JobError(
+                    f"{where}.{name}: a hinge needs an 'axis' in the joint's local frame")
             a = _vector(js["axis"], 3, f"{where}.{name}.axis")
             if np.linalg.norm(a) < 1e-9:
                 raise JobError(f"{where}.{name}.axis: the axis must not be zero")

@@ -36,7 +36,7 @@ class BodyPose:
     root_position: np.ndarray  # (3,) world position of the root joint
     views: list[View]
 
-    def copy(self) -> "BodyPose":
+    def copy(self) -> BodyPose:
         return BodyPose(
             self.rotations.copy(), self.root_position.copy(), [v.copy() for v in self.views]
         )

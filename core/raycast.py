@@ -111,7 +111,7 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     o00, d = view.ray(np.array([[0.0, 0.0]]))
     ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
     oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00[0]
-    for i, b in enumerate(blobs):
+    for i in range(len(blobs)):
         bb = _clip_box(boxes[i, :2], boxes[i, 2:], shape, 1)
         if bb is None:
             continue

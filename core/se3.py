@@ -195,7 +195,7 @@ class Similarity:
         """Map points (..., 3) to the scaled frame."""
         return self.s * (X @ self.R.T + self.t)
 
-    def compose(self, G: np.ndarray) -> "Similarity":
+    def compose(self, G: np.ndarray) -> Similarity:
         """self o G for a 4x4 rigid motion G applied first."""
         return Similarity(self.s, self.R @ G[:3, :3], self.R @ G[:3, 3] + self.t)
 
@@ -204,5 +204,5 @@ class Similarity:
         M = rigid(self.s * self.R, self.s * self.t)
         return M
 
-    def copy(self) -> "Similarity":
+    def copy(self) -> Similarity:
         return Similarity(self.s, self.R.copy(), self.t.copy())

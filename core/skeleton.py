@@ -262,7 +262,7 @@ def planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1)) -> Skeleton:
     """A chain along +x whose hinges all turn about ``axis`` (the view direction), for a limb
     or an animal seen from the side."""
     spec = [("Base", None, (0, 0, 0), FIXED)]
-    for i, L in enumerate(lengths):
+    for i in range(len(lengths)):
         parent = spec[-1][0]
         offset = (lengths[i - 1], 0, 0) if i else (0, 0, 0)
         spec.append((f"Link{i + 1}", parent, offset, HINGE, axis))

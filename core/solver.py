@@ -39,7 +39,7 @@ class NormalEquations:
     rows: int = 0
 
     @classmethod
-    def zeros(cls, n: int) -> "NormalEquations":
+    def zeros(cls, n: int) -> NormalEquations:
         return cls(np.zeros((n, n)), np.zeros(n))
 
     def add(self, A: np.ndarray, r: np.ndarray, w: np.ndarray) -> None:
@@ -98,10 +98,11 @@ def solve(
     if ne.rows == 0 or not np.all(np.isfinite(H)) or not np.all(np.isfinite(b)):
         raise DegenerateSystem("no usable pixels in any view")
     d = np.diag(H).copy()
-    scale = max(float(d.max()), 1e-300)
     pw = np.zeros(P) if prior is None else prior
-    # Jacobi scaling keeps radians, pixels and scale on one footing for the factorisation
-    diag = d * (1 + damping) + pw + 1e-12 * scale
+    # Jacobi scaling keeps radians, pixels and scale on one footing for the factorisation;
+    # an unknown no pixel sees (an all-zero column) gets a unit diagonal and stays put
+    diag = d * (1 + damping) + pw
+    diag[diag <= 0] = 1.0
     S = 1 / np.sqrt(diag)
     M = (H - np.diag(d)) * S[:, None] * S[None, :] + np.eye(P)
     rhs = -(b + (pw * offset if offset is not None else 0.0)) * S

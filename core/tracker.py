@@ -67,7 +67,7 @@ class FrameResult:
 
     frame: int
     pose: BodyPose
-    residual: float  # robust RMS of the finest level's last iteration, image units
+    residual: float  # support-weighted RMS brightness error on the finest level, image units
     iterations: int
     converged: bool
     diverged: bool = False
@@ -103,7 +103,7 @@ class _Samples:
 
     costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
     parts: list  # per set: (indices of usable points, their q, image gradients, residuals)
-    inside: float  # fraction of points inside the images
+    inside: np.ndarray  # (views,) fraction of each view's points inside its image
 
 
 class ImageSequence:
@@ -205,7 +205,8 @@ class Tracker:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
         where the point is hidden by another blob or off the image) and what the rows need."""
         s = self.settings
-        costs, parts, n_pts, n_inside = [], [], 0, 0
+        costs, parts = [], []
+        n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
         labels = [self._label_map(est, kin, c, levels[c].shape, lv)
                   for c in range(self.seq.n_views)]
         for ps, sigma in zip(sets, sigmas):
@@ -220,14 +221,14 @@ class Tracker:
             visible = np.zeros(len(pix), dtype=bool)
             visible[inb] = lab[p_l[inb, 1], p_l[inb, 0]] == ps.blob[inb]
             ok = np.flatnonzero(inside & visible)
-            n_pts += len(pix)
-            n_inside += int(inside.sum())
+            n_pts[ps.view] += len(pix)
+            n_inside[ps.view] += int(inside.sum())
             r = vals[ok, 0] - ps.value[ok]
             c = np.full(len(pix), np.nan)
             c[ok] = ps.weight[ok] * mixture_cost(r, sigma, s.outlier_density)
             costs.append(c)
             parts.append((ok, q[ok], vals[ok, 1:3], r))
-        return _Samples(np.concatenate(costs), parts, n_inside / n_pts if n_pts else 0.0)
+        return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1))
 
     def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
                           sigmas: list[float]) -> NormalEquations:
@@ -251,6 +252,23 @@ class Tracker:
             out.append(robust_scale(vals[inside, 0] - ps.value[inside], self.settings.noise_floor))
         return out
 
+    def _residual(self, sets: list[_PointSet], smp: _Samples, sigmas: list[float]) -> float:
+        """RMS brightness error of the pixels that follow the body (support-weighted), in
+        image units: what the report calls a frame's residual."""
+        num = den = 0.0
+        for ps, sigma, (ok, _, _, r) in zip(sets, sigmas, smp.parts):
+            w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+            num += float(np.sum(w * r * r))
+            den += float(np.sum(w))
+        return float(np.sqrt(num / den)) if den > 0 else float("nan")
+
+    def _left_views(self, smp: _Samples) -> str:
+        """'' while enough of the body is inside every image, else which views it left."""
+        gone = np.flatnonzero(smp.inside < self.settings.min_inside)
+        if not len(gone):
+            return ""
+        return "the body left the image of view " + ", ".join(str(c + 1) for c in gone)
+
     def _blob_pixels(self, pose: BodyPose) -> np.ndarray:
         """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
         g = self.skeleton.segment_motions(
@@ -268,7 +286,6 @@ class Tracker:
         offset = np.zeros(self.n_params)
         total_iters = 0
         converged = False
-        inside = 1.0
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for lv in reversed(range(s.levels)):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
@@ -285,6 +302,10 @@ class Tracker:
             sigmas = self._sigmas(est, kin, sets, levels)
             active = self._active(est, lv)
             smp = self._sample(est, kin, sets, levels, lv, sigmas)
+            left = self._left_views(smp)
+            if left:
+                return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
+                                   time.perf_counter() - t0)
             ne = self._normal_equations(kin, sets, smp, sigmas)
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
@@ -314,12 +335,10 @@ class Tracker:
                     if lam > 1e4:
                         converged = True  # no step lowers the cost: a minimum at this level
                         break
-            inside = smp.inside
-        ne = self._normal_equations(kin, sets, smp, sigmas)
-        residual = float(np.sqrt(ne.cost / max(ne.weight * s.noise_floor**2, 1e-12)))
-        result = FrameResult(frame, est, residual, total_iters, converged)
-        if inside < s.min_inside:
-            result.diverged, result.reason = True, "the body left the image"
+        result = FrameResult(frame, est, self._residual(sets, smp, sigmas), total_iters, converged)
+        left = self._left_views(smp)
+        if left:
+            result.diverged, result.reason = True, left
         result.seconds = time.perf_counter() - t0
         return result
 

@@ -1,0 +1,62 @@
+"""Damped least squares and the EM weights against direct computations."""
+
+import numpy as np
+import pytest
+
+from core.solver import (
+    DegenerateSystem,
+    NormalEquations,
+    mixture_cost,
+    solve,
+    support_weights,
+)
+
+
+def test_solves_a_consistent_system_exactly_without_damping():
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(200, 7)) * [1, 10, 100, 0.1, 1, 5, 0.01]  # badly scaled columns
+    x = rng.normal(size=7)
+    ne = NormalEquations.zeros(7)
+    ne.add(A, -(A @ x), np.ones(200))
+    np.testing.assert_allclose(solve(ne, 0.0), x, rtol=1e-8)
+
+
+def test_weights_and_damping_match_the_closed_form():
+    rng = np.random.default_rng(1)
+    A, r, w = rng.normal(size=(50, 4)), rng.normal(size=50), rng.uniform(0.1, 1, 50)
+    ne = NormalEquations.zeros(4)
+    ne.add(A[:20], r[:20], w[:20])
+    ne.add(A[20:], r[20:], w[20:])
+    H = A.T @ (w[:, None] * A)
+    b = A.T @ (w * r)
+    prior, offset, lam = np.array([0.0, 1.0, 2.0, 0.5]), rng.normal(size=4), 0.3
+    expect = np.linalg.solve(H + lam * np.diag(np.diag(H)) + np.diag(prior),
+                             -(b + prior * offset))
+    np.testing.assert_allclose(solve(ne, lam, prior, offset), expect, rtol=1e-9)
+
+
+def test_inactive_unknowns_stay_put_and_the_rest_solve_their_subsystem():
+    rng = np.random.default_rng(2)
+    A, r = rng.normal(size=(40, 5)), rng.normal(size=40)
+    ne = NormalEquations.zeros(5)
+    ne.add(A, r, np.ones(40))
+    active = np.array([True, False, True, True, False])
+    step = solve(ne, 0.0, active=active)
+    assert step[1] == 0 and step[4] == 0
+    sub = A[:, active]
+    np.testing.assert_allclose(step[active], np.linalg.lstsq(sub, -r, rcond=None)[0], rtol=1e-9)
+
+
+def test_no_rows_is_reported():
+    with pytest.raises(DegenerateSystem, match="no usable pixels"):
+        solve(NormalEquations.zeros(3), 1e-3)
+
+
+def test_support_weights_are_the_irls_weights_of_the_mixture_cost():
+    r = np.linspace(-0.1, 0.1, 41)
+    sigma, c, h = 0.02, 0.1, 1e-7
+    dcost = (mixture_cost(r + h, sigma, c) - mixture_cost(r - h, sigma, c)) / (2 * h)
+    np.testing.assert_allclose(support_weights(r, sigma, c) * r, dcost, atol=1e-5)
+    assert mixture_cost(np.array([0.0]), sigma, c)[0] == pytest.approx(0, abs=1e-15)
+    assert support_weights(np.array([0.2]), sigma, c)[0] < 1e-3 * support_weights(
+        np.array([0.0]), sigma, c)[0]

@@ -1,0 +1,123 @@
+"""The tracker on synthetic footage of its own blob model, where the true motion is known."""
+
+import numpy as np
+import pytest
+from support.synthetic import render, side_view
+
+from core import se3
+from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
+from core.skeleton import human_template
+from core.tracker import Tracker, TrackerSettings, track
+
+VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
+
+
+@pytest.fixture(scope="module")
+def body():
+    sk = human_template()
+    return sk, BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                        [v.copy() for v in VIEWS])
+
+
+def _limb_errors(sk, a: BodyPose, b: BodyPose) -> np.ndarray:
+    """Angles (degrees) between bone directions of two poses, every joint with a parent."""
+    Xa = sk.world_positions(a.rotations, a.root_position)
+    Xb = sk.world_positions(b.rotations, b.root_position)
+    j = np.arange(1, sk.n_joints)
+    p = sk.parents[j]
+    return np.degrees(se3.angle_between_vectors(Xa[j] - Xa[p], Xb[j] - Xb[p]))
+
+
+def _small_motion(sk, mode, n_views, seed):
+    rng = np.random.default_rng(seed)
+    P = n_root_params(mode, n_views) + len(sk.dof_names())
+    delta = rng.normal(0, 0.03, P)
+    if mode == CALIBRATED:
+        delta[:3] = rng.normal(0, 0.01, 3)
+    else:
+        for c in range(n_views):
+            delta[6 * c : 6 * c + 3] = [0.01, *rng.normal(0, 2, 2)]
+    return delta
+
+
+def test_identical_frames_give_exactly_no_motion(body):
+    sk, pose = body
+    frames = [[render(sk, pose, c)] * 3 for c in range(3)]
+    for mode in (CALIBRATED, INDEPENDENT):
+        res = track(Tracker(sk, frames, mode), pose, [0, 1, 2])
+        fr = res.frames[1]  # the Gauss-Newton step itself: exactly zero
+        np.testing.assert_array_equal(fr.pose.rotations, pose.rotations)
+        np.testing.assert_array_equal(fr.pose.root_position, pose.root_position)
+        for v, v0 in zip(fr.pose.views, pose.views):
+            np.testing.assert_array_equal(v.pose.t, v0.pose.t)
+            assert v.pose.s == v0.pose.s
+        fr = res.frames[2]  # after a (rounded) constant-velocity prediction of no motion
+        np.testing.assert_allclose(fr.pose.rotations, pose.rotations, atol=1e-12)
+        for v, v0 in zip(fr.pose.views, pose.views):
+            np.testing.assert_allclose(v.pose.t, v0.pose.t, atol=1e-12)
+
+
+@pytest.mark.parametrize("mode", [CALIBRATED, INDEPENDENT])
+def test_recovers_a_known_small_motion_in_three_views(body, mode):
+    sk, pose = body
+    moved = apply_update(sk, pose, _small_motion(sk, mode, 3, seed=4), mode)
+    frames = [[render(sk, pose, c), render(sk, moved, c, noise=0.01, seed=c)] for c in range(3)]
+    res = track(Tracker(sk, frames, mode, TrackerSettings(iterations=10)), pose, [0, 1])
+    est = res.frames[1].pose
+    before = _limb_errors(sk, pose, moved)
+    after = _limb_errors(sk, est, moved)
+    assert before.max() > 2.0  # the motion is real
+    assert after.max() < 0.5, after
+    assert np.linalg.norm(est.root_position - moved.root_position) < 2e-3
+    if mode == INDEPENDENT:
+        for v, t in zip(est.views, moved.views):
+            err = np.abs(v.project(sk.rest_positions) - t.project(sk.rest_positions)).max()
+            assert err < 0.3  # pixels
+
+
+def test_constant_velocity_prediction_continues_a_steady_motion(body):
+    sk, pose = body
+    delta = _small_motion(sk, INDEPENDENT, 3, seed=9)
+    p1 = apply_update(sk, pose, delta, INDEPENDENT)
+    p2 = extrapolate(pose, p1)
+    # the same step applied again, written in p1's own coordinates
+    for j in range(sk.n_joints):
+        step = pose.rotations[j].T @ p1.rotations[j]
+        np.testing.assert_allclose(p2.rotations[j], p1.rotations[j] @ step, atol=1e-12)
+    for v0, v1, v2 in zip(pose.views, p1.views, p2.views):
+        M0, M1, M2 = v0.pose.matrix(), v1.pose.matrix(), v2.pose.matrix()
+        np.testing.assert_allclose(M2, M1 @ np.linalg.inv(M0) @ M1, atol=1e-9)
+
+
+def test_cancel_keeps_the_frames_already_tracked(body):
+    sk, pose = body
+    frames = [[render(sk, pose, c)] * 6 for c in range(3)]
+    seen = []
+    res = track(Tracker(sk, frames, CALIBRATED), pose, range(6),
+                progress=lambda r, done, total: seen.append((r.frame, done, total)),
+                cancel=lambda: len(seen) >= 3)
+    assert res.cancelled and [f.frame for f in res.frames] == [0, 1, 2]
+    assert seen == [(0, 1, 6), (1, 2, 6), (2, 3, 6)]
+
+
+def test_a_body_that_leaves_the_images_is_reported_not_tracked(body):
+    sk, pose = body
+    frames = [[render(sk, pose, c), np.full((360, 320), 0.3, np.float32)] for c in range(3)]
+    shifted = pose.copy()
+    for v in shifted.views:
+        v.center = v.center + np.array([400.0, 0.0])  # the body starts off to the side
+    res = track(Tracker(sk, frames, INDEPENDENT), shifted, [0, 1])
+    assert res.frames[-1].diverged
+    assert res.frames[-1].reason == "the body left the image of view 1, 2, 3"
+    assert res.diverged_frames == [1]
+
+
+def test_bad_input_is_refused_with_a_reason(body):
+    sk, pose = body
+    frames = [[render(sk, pose, 0)] * 2]
+    with pytest.raises(ValueError, match="mode must be"):
+        Tracker(sk, frames, "perspective")
+    with pytest.raises(ValueError, match="the pose has 3 views, the footage 1"):
+        list(Tracker(sk, frames, CALIBRATED).iter_track(pose, [0, 1]))
+    with pytest.raises(IndexError, match="frame 5 is outside"):
+        list(Tracker(sk, [frames[0]] * 3, CALIBRATED).iter_track(pose, [0, 5]))
