@@ -52,7 +52,10 @@ JOINTS = {
 # blob short radii a user would set to line the blobs up with this body (metres)
 BLOBS = {
     "LHipJoint": {"radius": 0.1}, "RHipJoint": {"radius": 0.1},
-    "lowerback": {"radii": [0.12, 0.09]}, "Chest": {"radii": [0.13, 0.09]},
+    "lowerback": {"radii": [0.12, 0.09], "length": 0.2},
+    "Chest": {"radii": [0.13, 0.09], "length": 0.2},
+    "lowerneck": {"radii": [0.12, 0.08], "length": 0.16},  # the upper chest
+    "LThumb": False, "RThumb": False,
     "LeftHip": {"radius": 0.075}, "RightHip": {"radius": 0.075},
     "LeftKnee": {"radius": 0.05}, "RightKnee": {"radius": 0.05},
     "LeftAnkle": False, "RightAnkle": False,

@@ -18,8 +18,8 @@ never removed or changed in meaning. Relative paths are relative to the job file
 
 A camera maps a world point X (the BVH's units) to pixel = scale * (R X + t)[:2] + center,
 x right, y down. Joints not named under ``joints`` keep their initial rotation. A blob entry
-sets the short radius (``radius``, or two ``radii``) of every blob of that joint, or
-``false`` to drop them.
+sets the short radius (``radius``, or two ``radii``) and optionally the full ``length`` along
+the bone (centred on the bone) of every blob of that joint, or is ``false`` to drop them.
 """
 
 from __future__ import annotations
@@ -149,16 +149,21 @@ def _apply_blobs(sk: Skeleton, spec, where: str) -> None:
         if bs is False:
             sk.blobs = [b for b in sk.blobs if b.joint != j]
             continue
-        if not isinstance(bs, dict) or not ({"radius", "radii"} & bs.keys()):
-            raise JobError(f"{where}.{name}: expected {{\"radius\": r}}, {{\"radii\": [r1, r2]}}"
-                           " or false")
+        if not isinstance(bs, dict) or not ({"radius", "radii", "length"} & bs.keys()):
+            raise JobError(f"{where}.{name}: expected {{\"radius\": r}}, {{\"radii\": [r1, r2]}},"
+                           " an optional \"length\", or false")
         r = _vector(bs["radii"], 2, f"{where}.{name}.radii") if "radii" in bs else np.full(
-            2, float(bs["radius"]))
-        if np.any(r <= 0):
-            raise JobError(f"{where}.{name}: radii must be positive")
+            2, float(bs["radius"])) if "radius" in bs else None
+        length = bs.get("length")
+        if r is not None and np.any(r <= 0) or length is not None and not (
+                isinstance(length, (int, float)) and length > 0):
+            raise JobError(f"{where}.{name}: radii and length must be positive numbers")
         for b in sk.blobs:
             if b.joint == j:
-                b.radii[1:] = r
+                if r is not None:
+                    b.radii[1:] = r
+                if length is not None:
+                    b.radii[0] = length / 2
 
 
 def _settings(spec, where: str) -> TrackerSettings:

@@ -1,0 +1,136 @@
+"""The job file and the command line, end to end on footage written to disk."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from core import se3
+from core.bvh import read_bvh, write_bvh
+from core.job import JobError, load_job, parse_camera
+from core.pose import BodyPose
+from support.synthetic import render
+
+ROOT = Path(__file__).resolve().parents[2]
+JOINTS = {"LeftHip": "ball", "RightHip": "ball",
+          "LeftKnee": {"kind": "hinge", "axis": [0.94, 0.34, 0]},
+          "RightKnee": {"kind": "hinge", "axis": [0.94, -0.34, 0]}}
+CAMERA = {"model": "scaled_orthographic", "R": [[0, 0, 1], [0, -1, 0], [1, 0, 0]],
+          "t": [0.55, 0.85, 5.0], "scale": 150, "center": [160, 150]}
+FRONT = {"model": "scaled_orthographic", "R": [[1, 0, 0], [0, -1, 0], [0, 0, -1]],
+         "t": [-0.25, 0.85, 5.0], "scale": 150, "center": [160, 150]}
+_R60 = se3.exp_so3(np.radians([0, -30, 0])) @ np.array(CAMERA["R"], float).T
+OBLIQUE = dict(CAMERA, R=(_R60.T).tolist())
+
+
+@pytest.fixture(scope="module")
+def footage(tmp_path_factory, cmu_walk):
+    """Three frames of the CMU walk's own blobs in three views, as PNG files."""
+    folder = tmp_path_factory.mktemp("job")
+    b = read_bvh(cmu_walk)
+    b.motion = b.motion[600:612:4]
+    write_bvh(b, folder / "walk.bvh")
+    job = {"skeleton": {"bvh": "walk.bvh", "joints": JOINTS},
+           "initial": {"bvh": "walk.bvh", "frame": 0},
+           "views": [{"images": "side/*.png", "camera": CAMERA},
+                     {"images": "front/*.png", "camera": FRONT},
+                     {"images": "oblique/*.png", "camera": OBLIQUE}],
+           "mode": "calibrated", "settings": {"levels": 2, "iterations": 12}}
+    (folder / "job.json").write_text(json.dumps(job))
+    views = ["side", "front", "oblique"]
+    for v in views:  # placeholders, so that the job loads and gives its skeleton's blobs
+        (folder / v).mkdir()
+        for f in range(3):
+            cv2.imwrite(str(folder / v / f"{f:03d}.png"), np.zeros((4, 4), np.uint8))
+    loaded = load_job(folder / "job.json")
+    R, p = b.poses()
+    for c, v in enumerate(views):
+        for f in range(3):
+            pose = BodyPose(R[f], p[f], loaded.cameras)
+            img = render(loaded.skeleton, pose, c, shape=(300, 320), noise=0.01, seed=f)
+            cv2.imwrite(str(folder / v / f"{f:03d}.png"), (img * 255).astype(np.uint8))
+    return folder, job
+
+
+def _run(*args):
+    return subprocess.run([sys.executable, "-m", "core", *map(str, args)], cwd=ROOT,
+                          capture_output=True, text=True)
+
+
+def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path):
+    folder, _ = footage
+    out, rep = tmp_path / "out.bvh", tmp_path / "report.json"
+    proc = _run("track", folder / "job.json", "--out", out, "--report", rep)
+    assert proc.returncode == 0, proc.stderr
+    src, got = read_bvh(folder / "walk.bvh"), read_bvh(out)
+    assert got.names == src.names
+    assert [j.channels for j in got.joints] == [j.channels for j in src.joints]
+    assert len(got.motion) == 3
+    R_true, p_true = src.poses()
+    R_got, p_got = got.poses()
+    sk = load_job(folder / "job.json").skeleton
+    for f in range(3):
+        X, Y = sk.world_positions(R_got[f], p_got[f]), sk.world_positions(R_true[f], p_true[f])
+        for a, b in [("LeftHip", "LeftKnee"), ("LeftKnee", "LeftAnkle"),
+                     ("RightHip", "RightKnee"), ("RightKnee", "RightAnkle")]:
+            ja, jb = sk.index(a), sk.index(b)
+            err = se3.angle_between_vectors(X[jb] - X[ja], Y[jb] - Y[ja])
+            assert np.degrees(err) < 2.0, (f, a)
+        assert np.linalg.norm(p_got[f] - p_true[f]) < 0.005
+    untracked = src.names.index("LeftShoulder")  # keeps the initial rotation
+    np.testing.assert_allclose(R_got[:, untracked], np.repeat(R_true[:1, untracked], 3, 0),
+                               atol=1e-5)
+    report = json.loads(rep.read_text())
+    assert report["frames_tracked"] == 3 and report["diverged_frames"] == []
+    assert {"frame", "residual", "iterations", "converged", "seconds"} <= set(report["frames"][1])
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda j: j.pop("views"), "job.json: missing field 'views'"),
+        (lambda j: j["views"][0]["camera"].update(R=[[1, 0, 0], [0, 2, 0], [0, 0, 1]]),
+         r"job.json.views\[0\].camera.R: expected a 3x3 rotation matrix"),
+        (lambda j: j["views"][0]["camera"].update(model="perspective"),
+         "only 'scaled_orthographic' is supported"),
+        (lambda j: j["skeleton"]["joints"].update(Tail="ball"),
+         "job.json.skeleton.joints.Tail: no such joint"),
+        (lambda j: j["skeleton"]["joints"].update(LeftKnee={"kind": "hinge"}),
+         "a hinge needs an 'axis'"),
+        (lambda j: j["settings"].update(speed=3), "job.json.settings.speed: unknown setting"),
+        (lambda j: j["settings"].update(levels="many"), "settings.levels: expected a int"),
+        (lambda j: j["views"][0].update(images="nowhere/*.png"),
+         r"views\[0\].images: the pattern 'nowhere/\*.png' matches no file"),
+        (lambda j: j["views"].append({"images": ["side/000.png"], "camera": CAMERA}),
+         "every view needs the same number of frames, got 3, 3, 3, 1"),
+        (lambda j: j.update(mode="both"), "job.json.mode: expected 'calibrated' or"),
+        (lambda j: j["initial"].update(frame=7), r"initial.frame: 7 is outside 0..2"),
+    ],
+)
+def test_malformed_jobs_get_one_clear_error(footage, tmp_path, change, message):
+    folder, job = footage
+    bad = json.loads(json.dumps(job))
+    change(bad)
+    broken = folder / "job.json"  # the name the messages carry
+    good = broken.read_text()
+    broken.write_text(json.dumps(bad))
+    try:
+        with pytest.raises(JobError, match=message):
+            load_job(broken)
+        proc = _run("track", broken, "--out", tmp_path / "x.bvh")
+    finally:
+        broken.write_text(good)
+    assert proc.returncode == 2 and proc.stderr.startswith("error: job.json")
+    assert not (tmp_path / "x.bvh").exists()
+
+
+def test_camera_parsing_maps_world_points_as_documented():
+    view = parse_camera(CAMERA, "cam")
+    X = np.array([0.2, 1.0, -0.4])
+    R, t = np.array(CAMERA["R"], float), np.array(CAMERA["t"])
+    expect = 150 * (R @ X + t)[:2] + np.array(CAMERA["center"])
+    np.testing.assert_allclose(view.project(X), expect)
