@@ -111,6 +111,21 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     o00, d = view.ray(np.array([[0.0, 0.0]]))
     ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
     oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00[0]
+    # w(u, v) = w0 + u wx + v wy in each blob's normalised frame, so b = w.e is affine and
+    # disc = b^2 - a (|w|^2 - 1) quadratic in the pixel: all coefficients per blob up front
+    e = A @ d  # (E, 3)
+    w0 = np.einsum("eab,eb->ea", A, o00[0] - C)
+    wx, wy = A @ ox, A @ oy
+    a = np.sum(e * e, 1)
+    b0, bx, by = (np.sum(w * e, 1) for w in (w0, wx, wy))
+
+    def dot(p, q):
+        return np.sum(p * q, 1)
+
+    c00, c0x, c0y = dot(w0, w0) - 1, dot(w0, wx), dot(w0, wy)
+    cxx, cxy, cyy = dot(wx, wx), dot(wx, wy), dot(wy, wy)
+    d00, dx, dy = b0 * b0 - a * c00, 2 * (b0 * bx - a * c0x), 2 * (b0 * by - a * c0y)
+    dxx, dxy, dyy = bx * bx - a * cxx, 2 * (bx * by - a * cxy), by * by - a * cyy
     for i in range(len(blobs)):
         bb = _clip_box(boxes[i, :2], boxes[i, 2:], shape, 1)
         if bb is None:
@@ -120,21 +135,20 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
         u, v = xs[cx], ys[cy]
         if not len(u) or not len(v):
             continue
-        e = A[i] @ d
-        base = A[i] @ (o00[0] - C[i])
-        yx, yy = A[i] @ ox, A[i] @ oy
-        Y = base + u[None, :, None] * yx + v[:, None, None] * yy  # (h, w, 3)
-        a = e @ e
-        bq = Y @ e
-        cq = np.einsum("hwk,hwk->hw", Y, Y) - 1
-        disc = bq * bq - a * cq
+        du = (dxx[i] * u + dx[i]) * u
+        dv = (dyy[i] * v + dy[i]) * v + d00[i]
+        disc = du[None, :] + dv[:, None] + dxy[i] * np.outer(v, u)
         hit = disc > 0
-        lam = np.where(hit, (-bq - np.sqrt(np.where(hit, disc, 0))) / a, np.inf)
+        if not hit.any():
+            continue
+        bq = (b0[i] + by[i] * v)[:, None] + bx[i] * u[None, :]
+        lam = np.full(disc.shape, np.inf)
+        lam[hit] = (-bq[hit] - np.sqrt(disc[hit])) / a[i]
         D = depth[cy, cx]
         nearer = lam < D
         D[nearer] = lam[nearer]
         label[cy, cx][nearer] = i
-        rim[cy, cx][nearer] = np.clip(disc[nearer] / a, 0, 1)
+        rim[cy, cx][nearer] = np.clip(disc[nearer] / a[i], 0, 1)
     vv, uu = np.nonzero(label >= 0)
     pixels = np.stack([xs[uu], ys[vv]], 1)
     dep = depth[vv, uu]

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
-from support.synthetic import side_view
 
 from core import se3
 from core.linearize import Kinematics, rows
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, n_root_params
 from core.skeleton import human_template
+from support.synthetic import side_view
 
 
 def _pose(seed=0):

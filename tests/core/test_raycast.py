@@ -1,10 +1,10 @@
 """Ray casting against brute-force sampling along each pixel's ray."""
 
 import numpy as np
-from support.synthetic import side_view
 
 from core import raycast, se3
 from core.skeleton import human_template
+from support.synthetic import side_view
 
 
 def _posed(seed=3):

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
-from support.synthetic import render, side_view
 
 from core import se3
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.skeleton import human_template
 from core.tracker import Tracker, TrackerSettings, track
+from support.synthetic import render, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
 
