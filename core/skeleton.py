@@ -101,13 +101,24 @@ class Skeleton:
         return float(np.max(P.max(0) - P.min(0)))
 
     # --- degrees of freedom -------------------------------------------------------------
+    def bone_frame(self, j: int) -> np.ndarray:
+        """Rows: unit bone direction (toward the first child or end site that is away from the
+        joint, else local x) and two perpendiculars, in the joint's local frame."""
+        tips = [self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
+        tips = [t for t in tips if np.linalg.norm(t) > 1e-9]
+        u = tips[0] / np.linalg.norm(tips[0]) if tips else np.array([1.0, 0, 0])
+        v = np.cross(u, np.eye(3)[int(np.argmin(np.abs(u)))])
+        v /= np.linalg.norm(v)
+        return np.stack([u, v, np.cross(u, v)])
+
     def dof_joints_and_axes(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per degree of freedom: its joint and unit axis in the joint's local frame."""
+        """Per degree of freedom: its joint and unit axis in the joint's local frame. A ball's
+        three are its twist about the bone, then two swings across it (``bone_frame``)."""
         joints, axes = [], []
         for j, kind in enumerate(self.kinds):
             if kind == BALL:
                 joints += [j, j, j]
-                axes += list(np.eye(3))
+                axes += list(self.bone_frame(j))
             elif kind == HINGE:
                 a = np.asarray(self.axes[j], dtype=float)
                 joints.append(j)
@@ -118,7 +129,7 @@ class Skeleton:
         names = []
         for j, kind in enumerate(self.kinds):
             if kind == BALL:
-                names += [f"{self.names[j]}.{c}" for c in "xyz"]
+                names += [f"{self.names[j]}.{c}" for c in ("twist", "swing1", "swing2")]
             elif kind == HINGE:
                 names.append(self.names[j])
         return names

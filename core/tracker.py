@@ -163,6 +163,7 @@ class Tracker:
             thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
         self.dof_thickness = thin[skeleton.dof_joints_and_axes()[0]]
 
+
     def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
         """Unknowns solved on level ``lv``: the root always; a joint only where its blob is at
         least ``min_blob_pixels`` thick in the coarsest-scaled view, so that coarse levels do

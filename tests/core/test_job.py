@@ -39,7 +39,7 @@ def footage(tmp_path_factory, cmu_walk):
            "views": [{"images": "side/*.png", "camera": CAMERA},
                      {"images": "front/*.png", "camera": FRONT},
                      {"images": "oblique/*.png", "camera": OBLIQUE}],
-           "mode": "calibrated", "settings": {"levels": 2, "iterations": 12}}
+           "mode": "calibrated", "settings": {"levels": 2, "iterations": 20}}
     (folder / "job.json").write_text(json.dumps(job))
     views = ["side", "front", "oblique"]
     for v in views:  # placeholders, so that the job loads and gives its skeleton's blobs

@@ -31,7 +31,7 @@ def _limb_errors(sk, a: BodyPose, b: BodyPose) -> np.ndarray:
 def _small_motion(sk, mode, n_views, seed):
     rng = np.random.default_rng(seed)
     P = n_root_params(mode, n_views) + len(sk.dof_names())
-    delta = rng.normal(0, 0.03, P)
+    delta = rng.normal(0, 0.04, P)
     if mode == CALIBRATED:
         delta[:3] = rng.normal(0, 0.01, 3)
     else:
