@@ -138,17 +138,13 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
         du = (dxx[i] * u + dx[i]) * u
         dv = (dyy[i] * v + dy[i]) * v + d00[i]
         disc = du[None, :] + dv[:, None] + dxy[i] * np.outer(v, u)
-        hit = disc > 0
-        if not hit.any():
-            continue
         bq = (b0[i] + by[i] * v)[:, None] + bx[i] * u[None, :]
-        lam = np.full(disc.shape, np.inf)
-        lam[hit] = (-bq[hit] - np.sqrt(disc[hit])) / a[i]
+        lam = (-bq - np.sqrt(np.maximum(disc, 0))) / a[i]
         D = depth[cy, cx]
-        nearer = lam < D
-        D[nearer] = lam[nearer]
-        label[cy, cx][nearer] = i
-        rim[cy, cx][nearer] = np.clip(disc[nearer] / a[i], 0, 1)
+        nearer = (disc > 0) & (lam < D)
+        np.copyto(D, lam, where=nearer)
+        np.copyto(label[cy, cx], i, where=nearer)
+        np.copyto(rim[cy, cx], np.minimum(disc / a[i], 1.0), where=nearer)
     vv, uu = np.nonzero(label >= 0)
     pixels = np.stack([xs[uu], ys[vv]], 1)
     dep = depth[vv, uu]

@@ -8,6 +8,8 @@ stack along the leading axes where that is natural (``hat3``, ``exp_so3`` on (..
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 _SMALL = 1e-8
@@ -65,11 +67,28 @@ def exp_so3(w: np.ndarray) -> np.ndarray:
     .. math:: e^{[w]} = I + \\frac{\\sin t}{t}[w] + \\frac{1-\\cos t}{t^2}[w]^2,\\ t = |w|
     """
     w = np.asarray(w, dtype=float)
+    if w.shape == (3,):  # the common case, without array overhead
+        return _exp_so3_one(float(w[0]), float(w[1]), float(w[2]))
     theta = np.linalg.norm(w, axis=-1)
     A, B, _ = _sinc_terms(theta)
     W = hat3(w)
     eye = np.broadcast_to(np.eye(3), W.shape)
     return eye + A[..., None, None] * W + B[..., None, None] * (W @ W)
+
+
+def _exp_so3_one(x: float, y: float, z: float) -> np.ndarray:
+    """Rodrigues' formula for one rotation vector, in plain floats."""
+    t2 = x * x + y * y + z * z
+    if t2 < 1e-8:
+        A, B = 1 - t2 / 6 + t2 * t2 / 120, 0.5 - t2 / 24 + t2 * t2 / 720
+    else:
+        t = math.sqrt(t2)
+        A, B = math.sin(t) / t, (1 - math.cos(t)) / t2
+    return np.array([
+        [1 - B * (y * y + z * z), B * x * y - A * z, B * x * z + A * y],
+        [B * x * y + A * z, 1 - B * (x * x + z * z), B * y * z - A * x],
+        [B * x * z - A * y, B * y * z + A * x, 1 - B * (x * x + y * y)],
+    ])
 
 
 def log_so3(R: np.ndarray) -> np.ndarray:

@@ -68,6 +68,11 @@ class Skeleton:
         for j in range(J):
             base = self.rest_positions[self.parents[j]] if j else 0.0
             self.rest_positions[j] = base + self.offsets[j]
+        self._moved_by = np.zeros((J, J), dtype=bool)
+        for m in range(J):
+            self._moved_by[m, self.ancestors(m)] = True
+        self._moved_by.setflags(write=False)
+        self._dofs = None
 
     @property
     def n_joints(self) -> int:
@@ -113,7 +118,17 @@ class Skeleton:
 
     def dof_joints_and_axes(self) -> tuple[np.ndarray, np.ndarray]:
         """Per degree of freedom: its joint and unit axis in the joint's local frame. A ball's
-        three are its twist about the bone, then two swings across it (``bone_frame``)."""
+        three are its twist about the bone, then two swings across it (``bone_frame``).
+        Read-only arrays, recomputed only when ``kinds`` or ``axes`` change."""
+        key = (tuple(self.kinds), np.asarray(self.axes, dtype=float).tobytes())
+        if self._dofs is None or self._dofs[0] != key:
+            joints, axes = self._compute_dofs()
+            joints.setflags(write=False)
+            axes.setflags(write=False)
+            self._dofs = (key, (joints, axes))
+        return self._dofs[1]
+
+    def _compute_dofs(self) -> tuple[np.ndarray, np.ndarray]:
         joints, axes = [], []
         for j, kind in enumerate(self.kinds):
             if kind == BALL:
@@ -135,11 +150,9 @@ class Skeleton:
         return names
 
     def moved_by(self) -> np.ndarray:
-        """Boolean (J, J): ``[m, j]`` is True when joint j's rotation moves joint m's segment."""
-        M = np.zeros((self.n_joints, self.n_joints), dtype=bool)
-        for m in range(self.n_joints):
-            M[m, self.ancestors(m)] = True
-        return M
+        """Boolean (J, J), read-only: ``[m, j]`` is True when joint j's rotation moves joint
+        m's segment."""
+        return self._moved_by
 
     # --- forward kinematics --------------------------------------------------------------
     def joint_frames(self, rotations: np.ndarray, root_position: np.ndarray) -> np.ndarray:
