@@ -14,7 +14,7 @@ degenerate is reported as diverged instead of being accepted.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -344,10 +344,14 @@ class Tracker:
         return result
 
     # --- the sequence ----------------------------------------------------------------------
-    def iter_track(self, initial: BodyPose, frames: Sequence[int]) -> Iterator[FrameResult]:
-        """Track through ``frames`` (indices into every view's images, in tracking order; the
-        first is the frame ``initial`` is posed on). Yields one result per frame, the first
-        being the initial pose itself; stops after a divergence if the settings say so."""
+    def iter_track(self, initial: BodyPose, frames: Sequence[int],
+                   corrections: Mapping[int, BodyPose] | None = None) -> Iterator[FrameResult]:
+        """Track through ``frames`` (indices into every view's images, in tracking order,
+        forward or backward; the first is the frame ``initial`` is posed on). Yields one result
+        per frame, the first being the initial pose itself; stops after a divergence if the
+        settings say so. A frame in ``corrections`` (poses the user set) takes that pose as its
+        result and becomes the key frame that later frames are held against."""
+        corrections = corrections or {}
         frames = list(frames)
         n = self.seq.n_frames()
         for f in frames:
@@ -357,7 +361,7 @@ class Tracker:
             raise ValueError(
                 f"the pose has {len(initial.views)} views, the footage {self.seq.n_views}"
             )
-        key_frame = frames[0]
+        key_frame, key = frames[0], initial
         self._key_sets.clear()  # the key pose may differ from an earlier run's
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
         yield first
@@ -365,12 +369,20 @@ class Tracker:
         residuals: list[float] = []
         for frame in frames[1:]:
             prev = history[-1]
+            if frame in corrections:
+                key_frame, key = frame, corrections[frame].copy()
+                self._key_sets.clear()
+                res = FrameResult(frame, key.copy(), 0.0, 0, True)
+                self.seq.keep_only({(c, frame) for c in range(self.seq.n_views)})
+                yield res
+                history = history[-1:] + [res]
+                continue
             if len(history) >= 2:
                 pred = extrapolate(history[-2].pose, prev.pose, self.settings.prediction_gain)
             else:
                 pred = prev.pose.copy()
             try:
-                res = self._track_frame(prev.pose, prev.frame, initial, key_frame, pred, frame)
+                res = self._track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
             except DegenerateSystem as e:
                 res = FrameResult(frame, pred, float("nan"), 0, False, True, str(e))
             if not res.diverged:
@@ -399,12 +411,13 @@ def track(
     frames: Sequence[int],
     progress: Callable[[FrameResult, int, int], None] | None = None,
     cancel: Callable[[], bool] | None = None,
+    corrections: Mapping[int, BodyPose] | None = None,
 ) -> TrackResult:
     """Run ``Tracker.iter_track`` to the end, calling ``progress(result, done, total)`` after
     each frame and stopping (keeping what was tracked) when ``cancel()`` returns True."""
     out = TrackResult()
     total = len(frames)
-    for res in tracker.iter_track(initial, frames):
+    for res in tracker.iter_track(initial, frames, corrections):
         out.frames.append(res)
         if progress:
             progress(res, len(out.frames), total)

@@ -121,3 +121,43 @@ def test_bad_input_is_refused_with_a_reason(body):
         list(Tracker(sk, frames, CALIBRATED).iter_track(pose, [0, 1]))
     with pytest.raises(IndexError, match="frame 5 is outside"):
         list(Tracker(sk, [frames[0]] * 3, CALIBRATED).iter_track(pose, [0, 5]))
+
+
+def test_tracks_backward_and_takes_user_corrections_as_new_keys(body):
+    sk, pose = body
+    mode = CALIBRATED
+    p1 = apply_update(sk, pose, _small_motion(sk, mode, 3, seed=2) * 0.5, mode)
+    p2 = apply_update(sk, p1, _small_motion(sk, mode, 3, seed=3) * 0.5, mode)
+    p3 = apply_update(sk, p2, _small_motion(sk, mode, 3, seed=5) * 0.5, mode)
+    poses = [pose, p1, p2, p3]
+    frames = [[render(sk, p, c, noise=0.005, seed=i) for i, p in enumerate(poses)]
+              for c in range(3)]
+    settings = TrackerSettings(iterations=10)
+    back = track(Tracker(sk, frames, mode, settings), p2, [2, 1, 0])
+    assert [f.frame for f in back.frames] == [2, 1, 0]
+    assert _limb_errors(sk, back.frames[-1].pose, pose).max() < 0.5
+    fixed = p1.copy()
+    tracker = Tracker(sk, frames, mode, settings)
+    res = track(tracker, pose, [0, 1, 2, 3], corrections={1: fixed})
+    assert res.frames[1].iterations == 0
+    np.testing.assert_array_equal(res.frames[1].pose.rotations, fixed.rotations)
+    assert {k[0] for k in tracker._key_sets} == {1}  # frame 3 was held against frame 1
+    assert _limb_errors(sk, res.frames[3].pose, p3).max() < 0.5
+
+
+def test_a_frame_that_does_not_match_is_flagged_by_its_residual(body):
+    sk, pose = body
+    noise = np.random.default_rng(0).uniform(0, 1, (360, 320)).astype(np.float32)
+    frames = [[render(sk, pose, c, noise=0.01, seed=i) for i in range(3)] + [noise]
+              for c in range(3)]
+    res = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1, 2, 3])
+    assert [f.diverged for f in res.frames] == [False, False, False, True]
+    assert "residual" in res.frames[-1].reason
+
+
+def test_frames_may_differ_in_size_by_a_few_pixels(body):
+    sk, pose = body
+    moved = apply_update(sk, pose, _small_motion(sk, CALIBRATED, 3, seed=4), CALIBRATED)
+    frames = [[render(sk, pose, c), render(sk, moved, c, shape=(364, 317))] for c in range(3)]
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10)), pose, [0, 1])
+    assert _limb_errors(sk, res.frames[1].pose, moved).max() < 0.5
