@@ -44,6 +44,7 @@ class TrackerSettings:
     pixel_step: int = 2  # use every n-th pixel (both directions) at the finest level
     key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
     damping: float = 1e-2  # initial Levenberg-Marquardt lambda (Marquardt scaling)
+    max_step: float = 15.0  # degrees any joint may turn in one iteration
     prior: float = 0.0  # pull toward the predicted pose, relative to each unknown's information
     outlier_density: float = 0.1  # EM support map: flat outlier density (see solver)
     noise_floor: float = 0.01  # smallest residual scale, image units (0..1)
@@ -263,6 +264,14 @@ class Tracker:
             den += float(np.sum(w))
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
 
+    def _trust(self, delta: np.ndarray) -> np.ndarray:
+        """The step shortened so that no joint turns more than ``max_step`` degrees: far from
+        the linearisation point the rows no longer describe the motion, and a thin limb would
+        otherwise be flipped by one step."""
+        turn = np.max(np.abs(delta[self.n_params - self.n_dof:]), initial=0.0)
+        cap = np.radians(self.settings.max_step)
+        return delta * (cap / turn) if turn > cap else delta
+
     def _left_views(self, smp: _Samples) -> str:
         """'' while enough of the body is inside every image, else which views it left."""
         gone = np.flatnonzero(smp.inside < self.settings.min_inside)
@@ -313,7 +322,7 @@ class Tracker:
             converged = False
             for _ in range(s.iterations):
                 total_iters += 1
-                delta = solve(ne, lam, prior, offset, active)
+                delta = self._trust(solve(ne, lam, prior, offset, active))
                 cand = apply_update(self.skeleton, est, delta, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
                 c_smp = self._sample(cand, kin_c, sets, levels, lv, sigmas)
