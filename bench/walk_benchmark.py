@@ -19,6 +19,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
@@ -37,6 +39,30 @@ RUNS = {
     "3 views calibrated 30 fps": (["lateral", "endon", "oblique60"], "calibrated", 4),
     "1 lateral view 30 fps": (["lateral"], "calibrated", 4),
 }
+
+
+def one_step(job_path: Path, truth: tuple) -> evaluate.Scores:
+    """Each frame tracked alone from the true pose of the frame before, predicted from the true
+    poses of the two before (the first from the one before): how well a single step follows
+    the body, apart from how errors add up along the sequence."""
+    from core.pose import BodyPose, extrapolate
+    from core.tracker import Tracker
+
+    job = load_job(job_path)
+    sk = job.skeleton
+    tracker = Tracker(sk, job.images, job.mode, job.settings)
+
+    def pose(i):
+        return BodyPose(truth[0][i].copy(), truth[1][i].copy(), [c.copy() for c in job.cameras])
+
+    est_R, est_p = [truth[0][0]], [truth[1][0]]
+    for i in range(1, len(truth[0])):
+        pred = pose(i - 1) if i == 1 else extrapolate(pose(i - 2), pose(i - 1))
+        res = tracker.track_frame(pose(i - 1), i - 1, pose(0), 0, pred, i)
+        est_R.append(res.pose.rotations)
+        est_p.append(res.pose.root_position)
+    tracked = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+    return evaluate.score(sk, tracked, (np.array(est_R), np.array(est_p)), truth)
 
 
 def fmt(x, digits=1):
@@ -59,7 +85,7 @@ def main(argv=None) -> int:
     truth_all = truth_bvh.poses()
     settings = json.loads(a.settings)
 
-    results, refs = {}, {}
+    results, refs, steps = {}, {}, {}
     for name in a.runs.split(","):
         views, mode, step = RUNS[name]
         job_path = write_job(a.cache, name.replace(" ", "_"), views, mode,
@@ -86,6 +112,8 @@ def main(argv=None) -> int:
                 evaluate.score(sk, tracked_names, evaluate.held_still(truth), truth),
                 evaluate.score(sk, tracked_names, evaluate.best_fit(sk, truth), truth),
             )
+        if mode == "calibrated" and len(views) == 3:
+            steps[name] = one_step(job_path, truth)
         s = results[name][0]
         print(f"{name}: limb {s.limb_mean_deg:.1f} deg, {rep['frames_tracked']}/"
               f"{rep['frames_total']} frames, {rep['frames_per_second']:.1f} fps", flush=True)
@@ -118,6 +146,14 @@ def main(argv=None) -> int:
     for joint in results[names[0]][0].local_deg:
         cells = [f"{results[n][0].local_deg[joint]:.1f}" for n in names]
         print(f"| {joint} | " + " | ".join(cells) + f" | {ref15[1].local_deg[joint]:.1f} |")
+    if steps:
+        print("\n| one step from the true pose (°) | " + " | ".join(steps) + " |")
+        print("|---" * (len(steps) + 1) + "|")
+        for limb in next(iter(steps.values())).limb_deg:
+            print(f"| {limb} | " + " | ".join(f"{s.limb_deg[limb]:.1f}" for s in steps.values())
+                  + " |")
+        print("| mean of the eight limbs | " + " | ".join(
+            f"{s.limb_mean_deg:.1f}" for s in steps.values()) + " |")
     print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; 480x360 footage, "
           f"{len(JOINTS)} tracked joints (19 degrees of freedom)")
     return 0

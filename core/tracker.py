@@ -288,8 +288,10 @@ class Tracker:
                             for b in self.skeleton.blobs])
         return np.array([v.project(centres) for v in pose.views])
 
-    def _track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
-                     predicted: BodyPose, frame: int) -> FrameResult:
+    def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
+                    predicted: BodyPose, frame: int) -> FrameResult:
+        """One frame: refine ``predicted`` against the previous frame (``prev`` on
+        ``prev_frame``) and the key frame, coarse to fine. Raises DegenerateSystem."""
         s = self.settings
         t0 = time.perf_counter()
         est = predicted
@@ -391,7 +393,7 @@ class Tracker:
             else:
                 pred = prev.pose.copy()
             try:
-                res = self._track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
+                res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
             except DegenerateSystem as e:
                 res = FrameResult(frame, pred, float("nan"), 0, False, True, str(e))
             if not res.diverged:
