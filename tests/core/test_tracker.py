@@ -161,3 +161,29 @@ def test_frames_may_differ_in_size_by_a_few_pixels(body):
     frames = [[render(sk, pose, c), render(sk, moved, c, shape=(364, 317))] for c in range(3)]
     res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10)), pose, [0, 1])
     assert _limb_errors(sk, res.frames[1].pose, moved).max() < 0.5
+
+
+def test_a_planar_chain_seen_from_the_side_is_tracked_in_one_view():
+    from core.skeleton import planar_chain_template
+
+    sk = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
+    for b in sk.blobs:
+        b.radii[1:] = 0.07
+    view = side_view(yaw_deg=0, height=0.0, center=(110, 180))  # looks along the hinge axes
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3), [view])
+    moved = apply_update(sk, pose, np.array([0.01, 1.5, -2.0, 0, 0, 0.02, 0.08, -0.1, 0.12]),
+                         INDEPENDENT)
+    frames = [[render(sk, pose, 0), render(sk, moved, 0, noise=0.01)]]
+    res = track(Tracker(sk, frames, INDEPENDENT, TrackerSettings(iterations=10)), pose, [0, 1])
+    est = res.frames[1].pose
+
+    def joint_pixels(p: BodyPose) -> np.ndarray:
+        tip = sk.end_sites[-1][0]
+        M = sk.joint_frames(p.rotations, p.root_position)
+        X = np.vstack([M[:, :3, 3], M[-1, :3, :3] @ tip + M[-1, :3, 3]])
+        return p.views[0].project(X)
+
+    # the first hinge turns about the root like the view's own in-plane rotation: only the
+    # image of the chain is determined, and it is what is compared
+    assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 20
+    assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 0.5
