@@ -185,5 +185,5 @@ def test_a_planar_chain_seen_from_the_side_is_tracked_in_one_view():
 
     # the first hinge turns about the root like the view's own in-plane rotation: only the
     # image of the chain is determined, and it is what is compared
-    assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 20
+    assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 5
     assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 0.5
