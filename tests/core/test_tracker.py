@@ -171,7 +171,7 @@ def test_a_planar_chain_seen_from_the_side_is_tracked_in_one_view():
         b.radii[1:] = 0.07
     view = side_view(yaw_deg=0, height=0.0, center=(110, 180))  # looks along the hinge axes
     pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3), [view])
-    moved = apply_update(sk, pose, np.array([0.01, 1.5, -2.0, 0, 0, 0.02, 0.08, -0.1, 0.12]),
+    moved = apply_update(sk, pose, np.array([0.01, 1.5, -2.0, 0, 0, 0.02, 0.15, -0.2, 0.25]),
                          INDEPENDENT)
     frames = [[render(sk, pose, 0), render(sk, moved, 0, noise=0.01)]]
     res = track(Tracker(sk, frames, INDEPENDENT, TrackerSettings(iterations=10)), pose, [0, 1])
@@ -185,5 +185,5 @@ def test_a_planar_chain_seen_from_the_side_is_tracked_in_one_view():
 
     # the first hinge turns about the root like the view's own in-plane rotation: only the
     # image of the chain is determined, and it is what is compared
-    assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 5
+    assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 15
     assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 0.5
