@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test lint bench clean
+.PHONY: venv demo test lint bench extension clean
 
 venv: $(STAMP)
 
@@ -22,11 +22,15 @@ test: venv
 	$(PY) -m pytest
 
 lint: venv
-	$(VENV)/bin/ruff check core bench tests
+	$(VENV)/bin/ruff check core twist_addon bench tests scripts
 
 # The tracking benchmark (renders its footage once into .cache/, ~10 minutes).
 bench: venv
 	$(PY) bench/walk_benchmark.py
+
+# The installable extension, one zip per platform, into dist/ (downloads its wheels once).
+extension: venv
+	$(PY) scripts/build_extension.py
 
 clean:
 	rm -rf .cache dist .pytest_cache

@@ -34,27 +34,42 @@ from .solver import (
 )
 
 
+def _knob(default, doc: str):
+    return field(default=default, metadata={"doc": doc})
+
+
 @dataclass
 class TrackerSettings:
-    """Tracker knobs with their defaults; every field can be set from a job's ``settings``."""
+    """Tracker knobs with their defaults; every field can be set from a job's ``settings``,
+    and each field's ``metadata["doc"]`` says what it does (the add-on's tooltips)."""
 
-    levels: int = 3  # pyramid levels (1 = full resolution only)
-    highpass: float = 4.0  # remove shading: subtract the local mean over this sigma (level px)
-    iterations: int = 5  # Gauss-Newton iterations per level at most
-    pixel_step: int = 2  # use every n-th pixel (both directions) at the finest level
-    key_weight: float = 0.5  # weight of the key-frame rows against the previous frame's
-    damping: float = 1e-2  # initial Levenberg-Marquardt lambda (Marquardt scaling)
-    max_step: float = 15.0  # degrees any joint may turn in one iteration
-    prior: float = 0.0  # pull toward the predicted pose, relative to each unknown's information
-    outlier_density: float = 0.1  # EM support map: flat outlier density (see solver)
-    noise_floor: float = 0.01  # smallest residual scale, image units (0..1)
-    rim_width: float = 0.3  # blob outline band: weight rises from 0 to 1 across this part
-    prediction_gain: float = 1.0  # constant-velocity prediction (0 = hold the last pose)
-    converge_pixels: float = 0.2  # stop iterating when no blob moves more (level pixels)
-    min_blob_pixels: float = 1.0  # a joint is solved on levels where its blob is this thick
-    divergence_ratio: float = 3.0  # residual over the running median that flags divergence
-    min_inside: float = 0.5  # fraction of body pixels that must stay inside the images
-    stop_on_divergence: bool = True
+    levels: int = _knob(3, "Pyramid levels, coarse to fine (1: full resolution only)")
+    highpass: float = _knob(4.0, "Shading removal: subtract the local mean over this many "
+                            "pixels of each level (0: off)")
+    iterations: int = _knob(5, "Gauss-Newton iterations per pyramid level, at most")
+    pixel_step: int = _knob(2, "Use every n-th pixel across and down on the finest level")
+    key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
+                              "frame's: holds the track against drift")
+    damping: float = _knob(1e-2, "Initial Levenberg-Marquardt damping")
+    max_step: float = _knob(15.0, "Degrees any joint may turn in one iteration")
+    prior: float = _knob(0.0, "Pull toward the predicted pose, relative to what the pixels "
+                         "say about each unknown")
+    outlier_density: float = _knob(0.1, "Support maps: how likely a pixel is not to follow "
+                                   "its blob (background, occluders, highlights)")
+    noise_floor: float = _knob(0.01, "Smallest brightness noise assumed (0 to 1)")
+    rim_width: float = _knob(0.3, "Blob outline band whose pixels count less, as a share of "
+                             "the blob's radius")
+    prediction_gain: float = _knob(1.0, "Constant-velocity prediction of the next frame "
+                                   "(0: start from the last pose)")
+    converge_pixels: float = _knob(0.2, "Stop iterating a level when no blob moves more "
+                                   "pixels than this")
+    min_blob_pixels: float = _knob(1.0, "Solve a joint on levels where its blob is at least "
+                                   "this many pixels thick")
+    divergence_ratio: float = _knob(3.0, "Flag a frame whose residual exceeds the median so "
+                                    "far by this factor")
+    min_inside: float = _knob(0.5, "Flag a frame when less of the body than this stays "
+                              "inside a view's image")
+    stop_on_divergence: bool = _knob(True, "Stop at the first flagged frame")
 
     def __post_init__(self):
         for name in ("levels", "iterations", "pixel_step"):

@@ -1,0 +1,94 @@
+"""The extension as a user gets it: built into a zip by Blender's own tool, installed with
+Blender's own installer into an isolated user folder, enabled in a fresh Blender process, with
+scipy and OpenCV loaded from the extension's bundled wheels."""
+
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from core.tracker import TrackerSettings
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    dist = tmp_path_factory.mktemp("dist")
+    subprocess.run([sys.executable, str(ROOT / "scripts" / "build_extension.py"), "--out",
+                    str(dist)], check=True, capture_output=True, text=True)
+    zips = sorted(dist.glob("twist_mocap-*-linux_x64.zip"))
+    assert len(zips) == 1, list(dist.iterdir())
+    user = tmp_path_factory.mktemp("blender_user")
+    env = dict(os.environ, BLENDER_USER_RESOURCES=str(user))
+    install = f"""
+        import bpy
+        result = bpy.ops.extensions.package_install_files(
+            filepath={str(zips[0])!r}, repo="user_default", enable_on_install=True)
+        assert result == {{"FINISHED"}}, result
+    """
+    proc = subprocess.run([sys.executable, "-c", textwrap.dedent(install)], env=env,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return env, user
+
+
+def _in_blender(env, code: str) -> dict:
+    """Run code in a fresh process with the extension enabled; it sets ``out`` to report."""
+    script = textwrap.dedent("""
+        import json, bpy, addon_utils
+        addon_utils.enable("bl_ext.user_default.twist_mocap", default_set=True,
+                           handle_error=None)
+        out = {}
+    """) + textwrap.dedent(code) + "\nprint('RESULT' + json.dumps(out))\n"
+    proc = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True,
+                          text=True)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    line = next(x for x in proc.stdout.splitlines() if x.startswith("RESULT"))
+    return json.loads(line[len("RESULT"):])
+
+
+def test_bundled_wheels_load_from_the_extension(installed):
+    env, user = installed
+    out = _in_blender(env, """
+        import scipy, cv2, numpy
+        out = {"scipy": scipy.__file__, "cv2": cv2.__file__, "numpy": numpy.__version__,
+               "versions": [scipy.__version__, cv2.__version__]}
+    """)
+    site = str(user / "extensions" / ".local" / "lib")
+    assert out["scipy"].startswith(site) and out["cv2"].startswith(site), out
+    assert out["versions"] == ["1.17.1", "4.11.0"]
+    assert out["numpy"].startswith("1.26")  # Blender's own numpy, never bundled
+
+
+def test_scene_settings_mirror_the_core_tracker_settings(installed):
+    env, _ = installed
+    out = _in_blender(env, """
+        import dataclasses, importlib
+        pkg = "bl_ext.user_default.twist_mocap"
+        props = importlib.import_module(pkg + ".twist_addon.properties")
+        tracker = importlib.import_module(pkg + ".core.tracker")
+        scene = bpy.context.scene
+        pg = scene.twist.tracker
+        rna = pg.bl_rna.properties
+        out["defaults"] = {f.name: getattr(pg, f.name)
+                           for f in dataclasses.fields(tracker.TrackerSettings)}
+        out["tooltips"] = {f.name: rna[f.name].description
+                           for f in dataclasses.fields(tracker.TrackerSettings)}
+        pg.levels, pg.key_weight, pg.stop_on_divergence = 2, 0.25, False
+        s = props.settings_from_properties(pg)
+        out["changed"] = [s.levels, s.key_weight, s.stop_on_divergence]
+        out["mode"] = scene.twist.mode
+    """)
+    expect = {f.name: f.default for f in dataclasses.fields(TrackerSettings)}
+    assert out["defaults"].keys() == expect.keys()
+    for k, v in expect.items():
+        assert out["defaults"][k] == pytest.approx(v), k
+    assert all(len(t) > 15 for t in out["tooltips"].values()), out["tooltips"]
+    assert out["changed"] == [2, 0.25, False]
+    assert out["mode"] == "CALIBRATED"

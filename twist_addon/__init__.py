@@ -1,0 +1,21 @@
+"""The Blender side of twist-mocap: everything that touches bpy. Core stays bpy-free."""
+
+import bpy
+
+from . import properties
+
+MODULES = (properties,)
+
+
+def register():
+    for module in MODULES:
+        for cls in module.CLASSES:
+            bpy.utils.register_class(cls)
+        module.register()
+
+
+def unregister():
+    for module in reversed(MODULES):
+        module.unregister()
+        for cls in reversed(module.CLASSES):
+            bpy.utils.unregister_class(cls)

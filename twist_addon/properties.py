@@ -1,0 +1,77 @@
+"""What the scene keeps for tracking: the armature, the view mode and the tracker settings.
+
+The tracker settings mirror ``core.tracker.TrackerSettings`` field by field, with its
+documentation as tooltips, so that a new setting in core appears here without a second list.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import bpy
+
+from ..core.pose import CALIBRATED, INDEPENDENT
+from ..core.tracker import TrackerSettings
+
+_LIMITS = {  # soft ranges for the sliders; core validates the hard ones
+    "levels": (1, 6), "iterations": (1, 50), "pixel_step": (1, 8), "max_step": (0.5, 90.0),
+}
+
+
+def _property(f: dataclasses.Field):
+    kw = {"name": f.name.replace("_", " ").capitalize(), "description": f.metadata["doc"],
+          "default": f.default}
+    if isinstance(f.default, bool):
+        return bpy.props.BoolProperty(**kw)
+    lo, hi = _LIMITS.get(f.name, (0, None))
+    if isinstance(f.default, int):
+        return bpy.props.IntProperty(min=lo, soft_max=hi or 100, **kw)
+    return bpy.props.FloatProperty(min=lo, soft_max=hi or 100.0, precision=3, **kw)
+
+
+TWIST_PG_tracker_settings = type(
+    "TWIST_PG_tracker_settings",
+    (bpy.types.PropertyGroup,),
+    {"__annotations__": {f.name: _property(f) for f in dataclasses.fields(TrackerSettings)},
+     "__doc__": "Tracker settings (see core.tracker.TrackerSettings)"},
+)
+
+
+def settings_from_properties(pg) -> TrackerSettings:
+    """The core settings held by a TWIST_PG_tracker_settings."""
+    return TrackerSettings(**{f.name: getattr(pg, f.name)
+                              for f in dataclasses.fields(TrackerSettings)})
+
+
+def _is_armature(_self, obj) -> bool:
+    return obj.type == "ARMATURE"
+
+
+class TWIST_PG_scene(bpy.types.PropertyGroup):
+    """Per scene: the armature to track and how."""
+
+    armature: bpy.props.PointerProperty(
+        type=bpy.types.Object, poll=_is_armature, name="Armature",
+        description="The armature posed over the first frame; tracking keys its bones")
+    mode: bpy.props.EnumProperty(
+        name="Views",
+        description="How the views' cameras are used",
+        items=[
+            (CALIBRATED.upper(), "Calibrated", "The cameras are where the scene's cameras "
+             "are: one root motion, seen by every view"),
+            (INDEPENDENT.upper(), "Independent", "Each view tracks its own pose of the body "
+             "(cameras not calibrated to each other)"),
+        ],
+        default=CALIBRATED.upper())
+    tracker: bpy.props.PointerProperty(type=TWIST_PG_tracker_settings)
+
+
+CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_scene)
+
+
+def register():
+    bpy.types.Scene.twist = bpy.props.PointerProperty(type=TWIST_PG_scene)
+
+
+def unregister():
+    del bpy.types.Scene.twist
