@@ -1,0 +1,143 @@
+"""Armatures, poses and cameras through the bridge, against what Blender itself computes."""
+
+import numpy as np
+import pytest
+
+
+def _armature(bpy, rotated=True):
+    """A three-bone arm with rolls and bent rest axes on a rotated, scaled object."""
+    from mathutils import Euler, Vector
+
+    arm_data = bpy.data.armatures.new("rig")
+    arm = bpy.data.objects.new("rig", arm_data)
+    bpy.context.collection.objects.link(arm)
+    bpy.context.view_layer.objects.active = arm
+    bpy.ops.object.mode_set(mode="EDIT")
+    spec = [("root", None, (0, 0, 0), (0, 0.1, 0.3), 0.3),
+            ("upper", "root", (0, 0.1, 0.3), (0.3, 0.2, 0.5), 1.1),
+            ("lower", "upper", (0.3, 0.2, 0.5), (0.5, -0.1, 0.6), -0.7)]
+    for name, parent, head, tail, roll in spec:
+        b = arm_data.edit_bones.new(name)
+        b.head, b.tail, b.roll = Vector(head), Vector(tail), roll
+        b.head_radius = b.tail_radius = 0.05
+        if parent:
+            b.parent = arm_data.edit_bones[parent]
+            b.use_connect = True
+    bpy.ops.object.mode_set(mode="OBJECT")
+    if rotated:
+        arm.rotation_euler = Euler((0.3, -0.5, 1.2))
+        arm.location = (1.0, -2.0, 0.5)
+        arm.scale = (1.5, 1.5, 1.5)
+    bpy.context.view_layer.update()
+    return arm
+
+
+def _world_heads_tails(arm):
+    W = np.array(arm.matrix_world)
+    heads = [(W @ np.append(np.array(pb.head), 1))[:3] for pb in arm.pose.bones]
+    tails = [(W @ np.append(np.array(pb.tail), 1))[:3] for pb in arm.pose.bones]
+    return np.array(heads), np.array(tails)
+
+
+def test_forward_kinematics_match_blenders_pose(bpy_module, addon):
+    bpy = bpy_module
+    bridge = addon.twist_addon.bridge
+    arm = _armature(bpy)
+    sk = bridge.skeleton_from_armature(arm)
+    rng = np.random.default_rng(0)
+    for pb in arm.pose.bones:
+        q = rng.normal(size=4)
+        pb.rotation_mode = "QUATERNION"
+        pb.rotation_quaternion = q / np.linalg.norm(q)
+    arm.pose.bones["root"].location = (0.1, -0.2, 0.05)
+    arm.pose.bones["lower"].rotation_mode = "XZY"
+    arm.pose.bones["lower"].rotation_euler = (0.4, -0.3, 1.1)
+    bpy.context.view_layer.update()
+    R, root = bridge.pose_from_armature(arm, sk)
+    M = sk.joint_frames(R, root)
+    heads, tails = _world_heads_tails(arm)
+    np.testing.assert_allclose(M[:, :3, 3], heads, atol=1e-6)
+    g_all = sk.segment_motions(M)
+    for b in sk.blobs:  # each blob's far end is its bone's tail
+        g = g_all[b.joint]
+        far = b.centre + b.Q[:, 0] * b.radii[0]
+        np.testing.assert_allclose(g[:3, :3] @ far + g[:3, 3], tails[b.joint], atol=1e-6)
+
+
+def test_core_poses_written_back_reproduce_themselves(bpy_module, addon):
+    bpy = bpy_module
+    bridge = addon.twist_addon.bridge
+    from core import se3
+
+    arm = _armature(bpy)
+    sk = bridge.skeleton_from_armature(arm)
+    rng = np.random.default_rng(1)
+    R = np.array([se3.exp_so3(rng.normal(0, 0.6, 3)) for _ in range(sk.n_joints)])
+    root = sk.rest_positions[0] + rng.normal(0, 0.1, 3)
+    Q, loc = bridge.armature_rotations(arm, sk, R, root)
+    from mathutils import Matrix
+
+    for j, name in enumerate(sk.names):
+        pb = arm.pose.bones[name]
+        pb.rotation_mode = "QUATERNION"
+        pb.rotation_quaternion = Matrix(Q[j].tolist()).to_quaternion()
+    arm.pose.bones[sk.names[0]].location = loc
+    bpy.context.view_layer.update()
+    R2, root2 = bridge.pose_from_armature(arm, sk)
+    np.testing.assert_allclose(R2, R, atol=1e-6)
+    np.testing.assert_allclose(root2, root, atol=1e-6)
+
+
+def test_locks_choose_hinges_balls_and_fixed_joints(bpy_module, addon):
+    bpy = bpy_module
+    bridge = addon.twist_addon.bridge
+    arm = _armature(bpy)
+    arm.pose.bones["lower"].lock_rotation = (True, False, True)  # a hinge about local y
+    arm.pose.bones["upper"].lock_rotation = (False, False, False)
+    sk = bridge.skeleton_from_armature(arm)
+    assert sk.kinds == ["fixed", "ball", "hinge"]
+    C = bridge.bone_frames(arm)
+    np.testing.assert_allclose(sk.axes[2], C[2][:, 1])
+    arm.pose.bones["lower"].lock_rotation = (True, True, True)
+    assert bridge.skeleton_from_armature(arm).kinds[2] == "fixed"
+
+
+def test_orthographic_camera_projects_like_blender(bpy_module, addon):
+    bpy = bpy_module
+    bridge = addon.twist_addon.bridge
+    from bpy_extras.object_utils import world_to_camera_view
+    from mathutils import Euler, Vector
+
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = 480, 360
+    cam_data = bpy.data.cameras.new("cam")
+    cam_data.type = "ORTHO"
+    cam_data.ortho_scale = 3.2
+    cam_data.shift_x, cam_data.shift_y = 0.05, -0.1
+    cam = bpy.data.objects.new("cam", cam_data)
+    scene.collection.objects.link(cam)
+    cam.location = (4.0, -3.0, 1.5)
+    cam.rotation_euler = Euler((1.3, 0.1, 0.9))
+    bpy.context.view_layer.update()
+    view = bridge.view_from_camera(cam, scene)
+    pts = np.random.default_rng(2).normal(0, 0.8, (20, 3))
+    for X in pts:
+        u, v, _ = world_to_camera_view(scene, cam, Vector(X))
+        expect = np.array([u * 480 - 0.5, (1 - v) * 360 - 0.5])
+        np.testing.assert_allclose(view.project(X), expect, atol=1e-4)  # mathutils: float32
+
+
+def test_bad_objects_are_refused_with_a_reason(bpy_module, addon):
+    bpy = bpy_module
+    bridge = addon.twist_addon.bridge
+    empty = bpy.data.objects.new("empty_rig", bpy.data.armatures.new("empty_rig"))
+    with pytest.raises(bridge.BridgeError, match="'empty_rig' has no bones"):
+        bridge.skeleton_from_armature(empty)
+    persp = bpy.data.objects.new("persp", bpy.data.cameras.new("persp"))
+    with pytest.raises(bridge.BridgeError, match="'persp' is perspective"):
+        bridge.view_from_camera(persp, bpy.context.scene)
+    arm = _armature(bpy, rotated=False)
+    arm.scale = (1, 2, 1)
+    bpy.context.view_layer.update()
+    with pytest.raises(bridge.BridgeError, match="non-uniform scale"):
+        bridge.skeleton_from_armature(arm)

@@ -1,0 +1,137 @@
+"""Blender objects to core types and back: armatures, poses and cameras.
+
+Frames. Core's reference frame is Blender's world with the armature at rest; a joint is a
+bone's head, and its local rotation R_j turns the bone's subtree about the head in world-
+aligned axes. Blender keeps a pose bone's rotation Q_j in the bone's own rest axes; with
+C_j = (armature object rotation) @ (bone rest rotation), the two are conjugates:
+
+    R_j = C_j Q_j C_j^T,   Q_j = C_j^T R_j C_j.
+
+A bone whose rotation is locked on exactly two axes is a hinge about the third; one locked on
+all three stays fixed; any other is a ball. A bone's blob runs from its head to its tail with
+the mean of its envelope's head and tail radii.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core import se3
+from ..core.camera import View
+from ..core.skeleton import BALL, FIXED, HINGE, Skeleton, bone_blob
+
+
+class BridgeError(ValueError):
+    """A Blender object that cannot become a core one; the message says which and why."""
+
+
+def _matrix(m) -> np.ndarray:
+    return np.array([list(row) for row in m], dtype=float)
+
+
+def _object_rotation_and_scale(obj) -> tuple[np.ndarray, float]:
+    M = _matrix(obj.matrix_world)[:3, :3]
+    scales = np.linalg.norm(M, axis=0)
+    if np.ptp(scales) > 1e-6 * scales.max():
+        raise BridgeError(f"'{obj.name}' has a non-uniform scale {tuple(scales.round(4))}; "
+                          "apply the scale (Ctrl A) first")
+    return M / scales[0], float(scales[0])
+
+
+def bone_frames(arm) -> np.ndarray:
+    """C_j (J, 3, 3): each bone's rest axes in the world, in ``arm.data.bones`` order."""
+    R_obj, _ = _object_rotation_and_scale(arm)
+    return np.array([R_obj @ _matrix(b.matrix_local)[:3, :3] for b in arm.data.bones])
+
+
+def skeleton_from_armature(arm) -> Skeleton:
+    """The armature's rest pose as a core skeleton: one joint per bone, in bone order."""
+    bones = list(arm.data.bones)
+    if not bones:
+        raise BridgeError(f"the armature '{arm.name}' has no bones; add bones or a template")
+    names = [b.name for b in bones]
+    roots = [b.name for b in bones if b.parent is None]
+    if len(roots) != 1:
+        raise BridgeError(f"the armature '{arm.name}' has {len(roots)} root bones "
+                          f"({', '.join(roots)}); parent them under one root bone")
+    W = _matrix(arm.matrix_world)
+    heads = np.array([(W @ np.append(np.array(b.head_local), 1))[:3] for b in bones])
+    tails = np.array([(W @ np.append(np.array(b.tail_local), 1))[:3] for b in bones])
+    parents = [names.index(b.parent.name) if b.parent else -1 for b in bones]
+    offsets = np.array([heads[j] - (heads[p] if p >= 0 else 0) for j, p in enumerate(parents)])
+    C = bone_frames(arm)
+    kinds, axes = [], np.tile([1.0, 0.0, 0.0], (len(bones), 1))
+    for j, pb in enumerate(arm.pose.bones[b.name] for b in bones):
+        free = [k for k in range(3) if not pb.lock_rotation[k]]
+        if parents[j] < 0 or not free:
+            kinds.append(FIXED)
+        elif len(free) == 1:
+            kinds.append(HINGE)
+            axes[j] = C[j][:, free[0]]
+        else:
+            kinds.append(BALL)
+    sk = Skeleton(names=names, parents=parents, offsets=offsets, kinds=kinds, axes=axes)
+    _, s = _object_rotation_and_scale(arm)
+    sk.blobs = [bone_blob(j, b.name, heads[j], tails[j] - heads[j],
+                          s * (b.head_radius + b.tail_radius) / 2)
+                for j, b in enumerate(bones) if np.linalg.norm(tails[j] - heads[j]) > 1e-6]
+    return sk
+
+
+def _basis_rotation(pb) -> np.ndarray:
+    """A pose bone's rotation in its own axes, whatever its rotation mode."""
+    if pb.rotation_mode == "QUATERNION":
+        return _matrix(pb.rotation_quaternion.to_matrix())
+    if pb.rotation_mode == "AXIS_ANGLE":
+        a = pb.rotation_axis_angle
+        axis = np.array(a[1:])
+        return se3.exp_so3(axis / max(np.linalg.norm(axis), 1e-12) * a[0])
+    return _matrix(pb.rotation_euler.to_matrix())
+
+
+def pose_from_armature(arm, sk: Skeleton) -> tuple[np.ndarray, np.ndarray]:
+    """Core local rotations (J, 3, 3) and root position (3,) of the armature's current pose
+    (rotations and the root bone's location; other bones' locations are not tracked)."""
+    C = bone_frames(arm)
+    R = np.empty((sk.n_joints, 3, 3))
+    for j, name in enumerate(sk.names):
+        R[j] = C[j] @ _basis_rotation(arm.pose.bones[name]) @ C[j].T
+    root = arm.pose.bones[sk.names[0]]
+    _, s = _object_rotation_and_scale(arm)
+    loc = C[0] @ np.array(root.location) * s
+    return R, sk.rest_positions[0] + loc
+
+
+def armature_rotations(arm, sk: Skeleton, R: np.ndarray, root_position: np.ndarray):
+    """Blender's basis rotations (J, 3, 3) and the root bone's location (3,) for a core pose."""
+    C = bone_frames(arm)
+    Q = np.einsum("jba,jbc,jcd->jad", C, R, C)
+    _, s = _object_rotation_and_scale(arm)
+    loc = C[0].T @ (root_position - sk.rest_positions[0]) / s
+    return Q, loc
+
+
+def view_from_camera(cam, scene) -> View:
+    """The scaled orthographic view of an orthographic camera at the scene's resolution."""
+    if cam.type != "CAMERA":
+        raise BridgeError(f"'{cam.name}' is not a camera")
+    data = cam.data
+    if data.type != "ORTHO":
+        kind = {"PERSP": "perspective", "PANO": "panoramic"}.get(data.type, data.type.lower())
+        raise BridgeError(f"the camera '{cam.name}' is {kind}; the tracker needs an "
+                          "orthographic camera (Camera properties > Lens > Type)")
+    r = scene.render
+    W = r.resolution_x * r.resolution_percentage / 100
+    H = r.resolution_y * r.resolution_percentage / 100
+    if r.pixel_aspect_x != r.pixel_aspect_y:
+        raise BridgeError("the scene's pixels are not square (Output > Format > Aspect)")
+    fit = data.sensor_fit
+    span = W if fit == "HORIZONTAL" or fit == "AUTO" and W >= H else H
+    s = span / data.ortho_scale
+    M = _matrix(cam.matrix_world)
+    axes = M[:3, :3] / np.linalg.norm(M[:3, :3], axis=0)
+    R = np.stack([axes[:, 0], -axes[:, 1], -axes[:, 2]])  # x right, y down, z forward
+    t = -R @ M[:3, 3]
+    # shifting the lens right moves the picture left (and up moves it down)
+    center = np.array([(W - 1) / 2 - data.shift_x * span, (H - 1) / 2 + data.shift_y * span])
+    return View(se3.Similarity(s, R, t), center)
