@@ -258,12 +258,12 @@ def load_job(path: str | Path) -> Job:
     return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft))
 
 
-def world_root(job: Job, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:
+def world_root(mode: str, first_camera: View, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:
     """Root world rotation (3, 3) and position (3,) of a tracked pose. In independent mode the
-    root is read through the first view: the given camera undoes that view's tracked pose."""
-    if job.mode == CALIBRATED:
+    root is read through the first view: its given camera undoes that view's tracked pose."""
+    if mode == CALIBRATED:
         return pose.rotations[0], pose.root_position
-    cam, eff = job.cameras[0].pose, pose.views[0].pose
+    cam, eff = first_camera.pose, pose.views[0].pose
     R = cam.R.T @ eff.R @ pose.rotations[0]
     q = eff.apply(pose.root_position)
     p = cam.R.T @ (q / cam.s - cam.t)

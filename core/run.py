@@ -28,7 +28,7 @@ def result_bvh(job: Job, result: TrackResult):
     """The job's BVH hierarchy holding one frame per tracked frame."""
     rots, roots = [], []
     for fr in result.frames:
-        R0, p0 = world_root(job, fr.pose)
+        R0, p0 = world_root(job.mode, job.cameras[0], fr.pose)
         R = fr.pose.rotations.copy()
         R[0] = R0
         rots.append(R)

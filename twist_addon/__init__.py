@@ -2,20 +2,22 @@
 
 import bpy
 
-from . import properties
+from . import operators, properties
 
-MODULES = (properties,)
+MODULES = (properties, operators)
 
 
 def register():
     for module in MODULES:
         for cls in module.CLASSES:
             bpy.utils.register_class(cls)
-        module.register()
+        if hasattr(module, "register"):
+            module.register()
 
 
 def unregister():
     for module in reversed(MODULES):
-        module.unregister()
+        if hasattr(module, "unregister"):
+            module.unregister()
         for cls in reversed(module.CLASSES):
             bpy.utils.unregister_class(cls)

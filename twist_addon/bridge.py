@@ -9,7 +9,7 @@ C_j = (armature object rotation) @ (bone rest rotation), the two are conjugates:
 
 A bone whose rotation is locked on exactly two axes is a hinge about the third; one locked on
 all three stays fixed; any other is a ball. A bone's blob runs from its head to its tail with
-the mean of its envelope's head and tail radii.
+the mean of its envelope's head and tail radii; a bone whose envelope radii are zero has none.
 """
 
 from __future__ import annotations
@@ -74,7 +74,9 @@ def skeleton_from_armature(arm) -> Skeleton:
     _, s = _object_rotation_and_scale(arm)
     sk.blobs = [bone_blob(j, b.name, heads[j], tails[j] - heads[j],
                           s * (b.head_radius + b.tail_radius) / 2)
-                for j, b in enumerate(bones) if np.linalg.norm(tails[j] - heads[j]) > 1e-6]
+                for j, b in enumerate(bones)
+                if np.linalg.norm(tails[j] - heads[j]) > 1e-6
+                and b.head_radius + b.tail_radius > 0]
     return sk
 
 

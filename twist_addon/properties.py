@@ -1,4 +1,4 @@
-"""What the scene keeps for tracking: the armature, the view mode and the tracker settings.
+"""What the scene keeps for tracking: the armature, the views, the direction, the settings.
 
 The tracker settings mirror ``core.tracker.TrackerSettings`` field by field, with its
 documentation as tooltips, so that a new setting in core appears here without a second list.
@@ -47,6 +47,25 @@ def _is_armature(_self, obj) -> bool:
     return obj.type == "ARMATURE"
 
 
+def _is_camera(_self, obj) -> bool:
+    return obj.type == "CAMERA"
+
+
+class TWIST_PG_view(bpy.types.PropertyGroup):
+    """One view: a camera and the footage it sees, one image per scene frame."""
+
+    camera: bpy.props.PointerProperty(
+        type=bpy.types.Object, poll=_is_camera, name="Camera",
+        description="The orthographic camera the footage was seen through")
+    images: bpy.props.StringProperty(
+        name="Footage", subtype="FILE_PATH",
+        description="The footage's frames: a glob such as //walk/side_*.png (// is the .blend's "
+                    "folder), read in name order")
+    first_frame: bpy.props.IntProperty(
+        name="First Frame", default=1,
+        description="The scene frame that shows the footage's first image")
+
+
 class TWIST_PG_scene(bpy.types.PropertyGroup):
     """Per scene: the armature to track and how."""
 
@@ -64,9 +83,15 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
         ],
         default=CALIBRATED.upper())
     tracker: bpy.props.PointerProperty(type=TWIST_PG_tracker_settings)
+    views: bpy.props.CollectionProperty(type=TWIST_PG_view)
+    direction: bpy.props.EnumProperty(
+        name="Direction", default="FORWARD",
+        description="Which way to track from the current frame",
+        items=[("FORWARD", "Forward", "From the current frame to the scene's end frame"),
+               ("BACKWARD", "Backward", "From the current frame back to the scene's start")])
 
 
-CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_scene)
+CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_view, TWIST_PG_scene)
 
 
 def register():

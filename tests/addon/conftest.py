@@ -31,3 +31,11 @@ def addon():
         spec.loader.exec_module(module)
     importlib.import_module("twist_mocap.twist_addon.bridge")
     return sys.modules["twist_mocap"]
+
+
+@pytest.fixture(scope="session")
+def registered(addon):
+    """The add-on's classes registered once (they survive factory resets)."""
+    addon.twist_addon.register()
+    yield addon
+    addon.twist_addon.unregister()

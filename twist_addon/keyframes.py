@@ -1,0 +1,86 @@
+"""Tracked poses as keyframes on the armature, and their removal.
+
+Tracking writes keyframes of type GENERATED, so that clearing a track removes exactly what
+tracking wrote and never a key the user set. A ball joint is keyed as a quaternion, a hinge as
+the one Euler channel of its free axis, the root bone as location and quaternion.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mathutils import Matrix
+
+from ..core.skeleton import BALL, FIXED, HINGE, Skeleton
+from .bridge import armature_rotations
+
+TRACKED = "GENERATED"  # keyframe type of tracked keys
+
+
+def channels(arm, sk: Skeleton) -> list[tuple[str, str, int]]:
+    """(bone, data path, index) of every channel tracking keys."""
+    out = []
+    for j, (name, kind) in enumerate(zip(sk.names, sk.kinds)):
+        pb = f'pose.bones["{name}"]'
+        if j == 0:
+            out += [(name, f"{pb}.location", i) for i in range(3)]
+            out += [(name, f"{pb}.rotation_quaternion", i) for i in range(4)]
+        elif kind == BALL:
+            out += [(name, f"{pb}.rotation_quaternion", i) for i in range(4)]
+        elif kind == HINGE:
+            free = [k for k in range(3) if not arm.pose.bones[name].lock_rotation[k]]
+            out.append((name, f"{pb}.rotation_euler", free[0]))
+    return out
+
+
+def write_pose(arm, sk: Skeleton, frame: int, R: np.ndarray, root: np.ndarray) -> None:
+    """Key the core pose (local rotations R (J, 3, 3), root position (3,)) on ``frame``."""
+    Q, loc = armature_rotations(arm, sk, R, root)
+    for j, (name, kind) in enumerate(zip(sk.names, sk.kinds)):
+        if kind == FIXED and j:
+            continue
+        pb = arm.pose.bones[name]
+        if j == 0 or kind == BALL:
+            if pb.rotation_mode != "QUATERNION":
+                pb.rotation_mode = "QUATERNION"
+            q = Matrix(Q[j].tolist()).to_quaternion()
+            if q.dot(pb.rotation_quaternion) < 0:
+                q.negate()  # the same rotation, on the side that keeps the curves continuous
+            pb.rotation_quaternion = q
+            pb.keyframe_insert("rotation_quaternion", frame=frame, group=name, keytype=TRACKED)
+        else:
+            if pb.rotation_mode in ("QUATERNION", "AXIS_ANGLE"):
+                pb.rotation_mode = "XYZ"
+            free = [k for k in range(3) if not pb.lock_rotation[k]][0]
+            e = Matrix(Q[j].tolist()).to_euler(pb.rotation_mode)
+            pb.rotation_euler[free] = e[free]
+            pb.keyframe_insert("rotation_euler", index=free, frame=frame, group=name,
+                               keytype=TRACKED)
+        if j == 0:
+            pb.location = loc
+            pb.keyframe_insert("location", frame=frame, group=name, keytype=TRACKED)
+
+
+def clear(arm, sk: Skeleton, frames: set[int] | None = None) -> int:
+    """Remove tracked keys (of the given frames, or all) from the tracked channels; returns how
+    many were removed. Keys the user set are kept."""
+    from bpy_extras import anim_utils
+
+    ad = arm.animation_data
+    if ad is None or ad.action is None:
+        return 0
+    bag = anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot)
+    if bag is None:
+        return 0
+    wanted = {(path, i) for _, path, i in channels(arm, sk)}
+    removed = 0
+    for fc in list(bag.fcurves):
+        if (fc.data_path, fc.array_index) not in wanted:
+            continue
+        for kp in reversed(list(fc.keyframe_points)):
+            f = int(round(kp.co[0]))
+            if kp.type == TRACKED and (frames is None or f in frames):
+                fc.keyframe_points.remove(kp)
+                removed += 1
+        if not len(fc.keyframe_points):
+            bag.fcurves.remove(fc)
+    return removed

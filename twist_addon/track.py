@@ -1,0 +1,93 @@
+"""A tracking run on the scene: gather the armature, views and footage, step the core tracker
+frame by frame, key each tracked frame. The Track operator drives it (all at once from a
+script, one frame per timer tick in the UI)."""
+
+from __future__ import annotations
+
+import glob
+from dataclasses import dataclass, field
+
+import bpy
+
+from ..core.job import world_root
+from ..core.pose import BodyPose
+from ..core.tracker import FrameResult, Tracker
+from . import keyframes
+from .bridge import BridgeError, pose_from_armature, skeleton_from_armature, view_from_camera
+from .properties import settings_from_properties
+
+
+def footage_frames(view_pg, frames: list[int]) -> list[str]:
+    """The image file of every scene frame in ``frames`` for one view; BridgeError names the
+    view and the first frame without an image."""
+    cam = view_pg.camera.name if view_pg.camera else "(no camera)"
+    if not view_pg.images:
+        raise BridgeError(f"the view of '{cam}' has no footage; set its images")
+    paths = sorted(glob.glob(bpy.path.abspath(view_pg.images)))
+    if not paths:
+        raise BridgeError(f"the footage of the view of '{cam}' ({view_pg.images}) matches no "
+                          "file")
+    out = []
+    for f in frames:
+        i = f - view_pg.first_frame
+        if not 0 <= i < len(paths):
+            raise BridgeError(f"the view of '{cam}' has no image for frame {f} (its "
+                              f"{len(paths)} images cover frames {view_pg.first_frame}-"
+                              f"{view_pg.first_frame + len(paths) - 1})")
+        out.append(paths[i])
+    return out
+
+
+@dataclass
+class TrackSession:
+    """Everything one run needs, checked before the first frame is tracked."""
+
+    armature: bpy.types.Object
+    frames: list[int]
+    tracker: Tracker
+    initial: BodyPose
+    tracked: list[FrameResult] = field(default_factory=list)
+
+    @classmethod
+    def from_scene(cls, scene) -> TrackSession:
+        tw = scene.twist
+        arm = tw.armature
+        if arm is None:
+            raise BridgeError("no armature is set to track (Twist Mocap > Armature)")
+        if not tw.views:
+            raise BridgeError("there are no views; add a camera with its footage")
+        cur = scene.frame_current
+        if tw.direction == "FORWARD":
+            frames = list(range(cur, scene.frame_end + 1))
+        else:
+            frames = list(range(cur, scene.frame_start - 1, -1))
+        if len(frames) < 2:
+            raise BridgeError(f"nothing to track {tw.direction.lower()} from frame {cur}")
+        views, images = [], []
+        for v in tw.views:
+            if v.camera is None:
+                raise BridgeError("a view has no camera; pick its camera or remove the view")
+            views.append(view_from_camera(v.camera, scene))
+            images.append(footage_frames(v, frames))
+        sk = skeleton_from_armature(arm)
+        if not sk.dof_names():
+            raise BridgeError(f"no bone of '{arm.name}' is free to turn: unlock the rotations "
+                              "of the bones to track")
+        R, root = pose_from_armature(arm, sk)
+        settings = settings_from_properties(tw.tracker)
+        # the tracker indexes frames 0..n-1 in tracking order
+        tracker = Tracker(sk, images, tw.mode.lower(), settings)
+        return cls(arm, frames, tracker, BodyPose(R, root, views))
+
+    def run(self):
+        """Yield after each frame is tracked and keyed."""
+        sk = self.tracker.skeleton
+        steps = self.tracker.iter_track(self.initial, range(len(self.frames)))
+        for res in steps:
+            frame = self.frames[res.frame]
+            if res.frame and not res.diverged:
+                R = res.pose.rotations.copy()
+                R[0], root = world_root(self.tracker.mode, self.initial.views[0], res.pose)
+                keyframes.write_pose(self.armature, sk, frame, R, root)
+            self.tracked.append(res)
+            yield res
