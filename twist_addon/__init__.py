@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import operators, properties
+from . import operators, panels, properties
 
-MODULES = (properties, operators)
+MODULES = (properties, operators, panels)
 
 
 def register():

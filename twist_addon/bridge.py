@@ -137,3 +137,43 @@ def view_from_camera(cam, scene) -> View:
     # shifting the lens right moves the picture left (and up moves it down)
     center = np.array([(W - 1) / 2 - data.shift_x * span, (H - 1) / 2 + data.shift_y * span])
     return View(se3.Similarity(s, R, t), center)
+
+
+# core templates are y up and face +z; Blender is z up and a character faces -y
+_CORE_TO_BLENDER = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
+
+
+def armature_from_skeleton(sk: Skeleton, name: str, collection):
+    """A new armature object whose bones are the skeleton's joints (head at the joint, tail at
+    its first child or end site), locked to the joint's kind: a hinge's free axis is the
+    bone's local z, aligned with the hinge axis; envelope radii are the blobs' radii."""
+    import bpy
+    from mathutils import Vector
+
+    data = bpy.data.armatures.new(name)
+    obj = bpy.data.objects.new(name, data)
+    collection.objects.link(obj)
+    view_layer = bpy.context.view_layer
+    view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    T = _CORE_TO_BLENDER
+    heads = sk.rest_positions @ T.T
+    radius = {b.joint: float(np.mean(b.radii[1:])) for b in sk.blobs}
+    for j, joint in enumerate(sk.names):
+        tips = [sk.offsets[c] for c in sk.children(j)] + list(sk.end_sites[j])
+        tips = [t for t in tips if np.linalg.norm(t) > 1e-6]
+        d = T @ tips[0] if tips else np.array([0, 0, 0.05])
+        eb = data.edit_bones.new(joint)
+        eb.head, eb.tail = Vector(heads[j]), Vector(heads[j] + d)
+        if sk.parents[j] >= 0:
+            eb.parent = data.edit_bones[sk.names[sk.parents[j]]]
+        if sk.kinds[j] == HINGE:
+            eb.align_roll(Vector(T @ sk.axes[j]))
+        eb.head_radius = eb.tail_radius = radius.get(j, 0.0)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for j, joint in enumerate(sk.names):
+        pb = obj.pose.bones[joint]
+        kind = sk.kinds[j] if j else BALL
+        pb.lock_rotation = {FIXED: (True,) * 3, HINGE: (True, True, False)}.get(kind, (False,) * 3)
+        pb.rotation_mode = "XYZ" if kind == HINGE else "QUATERNION"
+    return obj

@@ -1,15 +1,20 @@
-"""Operators: Track (modal on a timer in the UI, synchronous from scripts) and Clear Track.
+"""Operators: Track (modal on a timer in the UI, synchronous from scripts), Clear Track, and
+adding views and template armatures.
 
-Operator ids are a public contract: ``twist.track`` and ``twist.clear_track``.
+Operator ids are a public contract: ``twist.track``, ``twist.clear_track``,
+``twist.add_template_armature``, ``twist.add_view`` and ``twist.remove_view``.
 """
 
 from __future__ import annotations
+
+import glob
+from pathlib import Path
 
 import bpy
 
 from ..core.image import ImageError
 from ..core.job import JobError
-from .bridge import BridgeError, skeleton_from_armature
+from .bridge import BridgeError, armature_from_skeleton, skeleton_from_armature
 from .keyframes import clear
 from .track import TrackSession
 
@@ -57,6 +62,11 @@ class TWIST_OT_track(bpy.types.Operator):
     def _finish(self, context, cancelled: bool) -> set:
         level, msg = _summary(self._session, cancelled)
         self.report(level, msg)
+        result, tracked = context.scene.twist.result, self._session.tracked
+        result.frames_tracked = sum(1 for r in tracked[1:] if not r.diverged)
+        result.last_residual = tracked[-1].residual if len(tracked) > 1 else 0.0
+        result.diverged_frames = ", ".join(
+            f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
         context.scene.frame_set(context.scene.frame_current)
         return {"FINISHED"}
 
@@ -128,4 +138,110 @@ class TWIST_OT_clear_track(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (TWIST_OT_track, TWIST_OT_clear_track)
+TEMPLATES = {
+    "HUMAN": ("Human (19 degrees of freedom)", "Ball hips, shoulders and neck; hinge knees and "
+              "elbows", "human_template"),
+    "WALKER": ("Walker (6, from the side)", "Hinge hips, knees and ankles turning in the view's "
+               "plane", "walker_template"),
+    "QUADRUPED": ("Quadruped (planar)", "Trunk, neck, head and four two-joint legs, all "
+                  "turning in the view's plane", "planar_quadruped_template"),
+}
+
+
+class TWIST_OT_add_template_armature(bpy.types.Operator):
+    """Add an armature for tracking, its bones locked to the template's hinges and balls"""
+
+    bl_idname = "twist.add_template_armature"
+    bl_label = "Add Template Armature"
+    bl_options = {"REGISTER", "UNDO"}
+
+    template: bpy.props.EnumProperty(
+        name="Template", description="The body to track",
+        items=[(k, v[0], v[1]) for k, v in TEMPLATES.items()])
+
+    def execute(self, context):
+        from ..core import skeleton
+
+        sk = getattr(skeleton, TEMPLATES[self.template][2])()
+        if context.object and context.object.mode != "OBJECT":
+            bpy.ops.object.mode_set(mode="OBJECT")
+        arm = armature_from_skeleton(sk, self.template.title(), context.collection)
+        context.scene.twist.armature = arm
+        self.report({"INFO"}, f"added '{arm.name}': {len(sk.dof_names())} degrees of freedom")
+        return {"FINISHED"}
+
+
+class TWIST_OT_add_view(bpy.types.Operator):
+    """Add a view: an orthographic camera with the footage behind it, one image per frame"""
+
+    bl_idname = "twist.add_view"
+    bl_label = "Add View"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: bpy.props.StringProperty(
+        name="Footage", subtype="FILE_PATH",
+        description="Any image of the footage; its folder's images of the same kind are read "
+                    "in name order")
+    first_frame: bpy.props.IntProperty(
+        name="First Frame", default=1,
+        description="The scene frame that shows the footage's first image")
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        path = Path(bpy.path.abspath(self.filepath))
+        if not path.is_file():
+            self.report({"ERROR"}, f"{self.filepath}: no such image file")
+            return {"CANCELLED"}
+        pattern = str(path.parent / f"*{path.suffix}")
+        count = len(glob.glob(pattern))
+        scene = context.scene
+        n = len(scene.twist.views) + 1
+        cam_data = bpy.data.cameras.new(f"View {n}")
+        cam_data.type = "ORTHO"
+        cam_data.show_background_images = True
+        cam = bpy.data.objects.new(f"View {n}", cam_data)
+        context.collection.objects.link(cam)
+        cam.location = (0.0, -10.0, 1.0)
+        cam.rotation_euler = (1.5707963, 0.0, 0.0)  # looking along +y, z up: a side view
+        image = bpy.data.images.load(str(path), check_existing=True)
+        image.source = "SEQUENCE" if count > 1 else "FILE"
+        bg = cam_data.background_images.new()
+        bg.image = image
+        bg.image_user.frame_start = self.first_frame
+        bg.image_user.frame_duration = count
+        bg.frame_method = "FIT"
+        img_w, img_h = image.size
+        if img_w and img_h and n == 1:
+            scene.render.resolution_x, scene.render.resolution_y = img_w, img_h
+        view = scene.twist.views.add()
+        view.camera = cam
+        view.images = bpy.path.relpath(pattern) if bpy.data.filepath else pattern
+        view.first_frame = self.first_frame
+        scene.twist.active_view = len(scene.twist.views) - 1
+        self.report({"INFO"}, f"added '{cam.name}' with {count} images")
+        return {"FINISHED"}
+
+
+class TWIST_OT_remove_view(bpy.types.Operator):
+    """Remove the selected view (its camera stays in the scene)"""
+
+    bl_idname = "twist.remove_view"
+    bl_label = "Remove View"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return len(context.scene.twist.views) > 0
+
+    def execute(self, context):
+        tw = context.scene.twist
+        tw.views.remove(tw.active_view)
+        tw.active_view = max(0, min(tw.active_view, len(tw.views) - 1))
+        return {"FINISHED"}
+
+
+CLASSES = (TWIST_OT_track, TWIST_OT_clear_track, TWIST_OT_add_template_armature,
+           TWIST_OT_add_view, TWIST_OT_remove_view)

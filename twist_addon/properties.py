@@ -66,6 +66,18 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
         description="The scene frame that shows the footage's first image")
 
 
+class TWIST_PG_result(bpy.types.PropertyGroup):
+    """What the last Track run did, for the Results panel."""
+
+    frames_tracked: bpy.props.IntProperty(
+        name="Frames Tracked", description="Frames the last run tracked and keyed")
+    last_residual: bpy.props.FloatProperty(
+        name="Last Residual", precision=4,
+        description="RMS brightness error of the last tracked frame (0 to 1)")
+    diverged_frames: bpy.props.StringProperty(
+        name="Diverged", description="Frames where the last run stopped, and why")
+
+
 class TWIST_PG_scene(bpy.types.PropertyGroup):
     """Per scene: the armature to track and how."""
 
@@ -84,6 +96,8 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
         default=CALIBRATED.upper())
     tracker: bpy.props.PointerProperty(type=TWIST_PG_tracker_settings)
     views: bpy.props.CollectionProperty(type=TWIST_PG_view)
+    active_view: bpy.props.IntProperty(name="Active View", description="The selected view")
+    result: bpy.props.PointerProperty(type=TWIST_PG_result)
     direction: bpy.props.EnumProperty(
         name="Direction", default="FORWARD",
         description="Which way to track from the current frame",
@@ -91,7 +105,7 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
                ("BACKWARD", "Backward", "From the current frame back to the scene's start")])
 
 
-CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_view, TWIST_PG_scene)
+CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_view, TWIST_PG_result, TWIST_PG_scene)
 
 
 def register():

@@ -141,3 +141,25 @@ def test_bad_objects_are_refused_with_a_reason(bpy_module, addon):
     bpy.context.view_layer.update()
     with pytest.raises(bridge.BridgeError, match="non-uniform scale"):
         bridge.skeleton_from_armature(arm)
+
+
+@pytest.mark.parametrize("template", ["HUMAN", "WALKER", "QUADRUPED"])
+def test_template_armatures_come_back_as_their_skeletons(bpy_module, registered, template):
+    bpy = bpy_module
+    from core import skeleton
+
+    bridge = registered.twist_addon.bridge
+    assert bpy.ops.twist.add_template_armature(template=template) == {"FINISHED"}
+    arm = bpy.context.scene.twist.armature
+    back = bridge.skeleton_from_armature(arm)
+    name = registered.twist_addon.operators.TEMPLATES[template][2]
+    core_sk = getattr(skeleton, name)()
+    assert back.names == core_sk.names
+    assert back.kinds[1:] == core_sk.kinds[1:]  # the root moves by its keys, not by a joint
+    assert back.dof_names() == core_sk.dof_names()
+    T = bridge._CORE_TO_BLENDER
+    np.testing.assert_allclose(back.offsets[1:], core_sk.offsets[1:] @ T.T, atol=1e-6)
+    dj, da = back.dof_joints_and_axes()
+    cj, ca = core_sk.dof_joints_and_axes()
+    hinge = [k for k, j in enumerate(cj) if core_sk.kinds[j] == "hinge"]
+    np.testing.assert_allclose(np.abs(da[hinge]), np.abs(ca[hinge] @ T.T), atol=1e-6)

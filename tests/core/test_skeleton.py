@@ -10,6 +10,7 @@ from core.skeleton import (
     HINGE,
     human_template,
     planar_chain_template,
+    planar_quadruped_template,
     skeleton_from_bvh,
     walker_template,
 )
@@ -53,7 +54,12 @@ def test_templates_have_the_named_degrees_of_freedom():
     chain = planar_chain_template(axis=(0, 0, 1))
     _, axes = chain.dof_joints_and_axes()
     np.testing.assert_allclose(axes, np.tile([0, 0, 1.0], (len(axes), 1)))
-    for sk in (human, walker, chain):
+    horse = planar_quadruped_template()
+    _, axes = horse.dof_joints_and_axes()
+    assert len(axes) == 10  # neck, head, two joints on each of four legs
+    np.testing.assert_allclose(axes, np.tile([0, 0, 1.0], (10, 1)))
+    assert [b.name for b in horse.blobs if b.joint == 0] == ["Trunk"]
+    for sk in (human, walker, chain, horse):
         assert sk.blobs and all(np.all(b.radii > 0) for b in sk.blobs)
 
 

@@ -1,0 +1,81 @@
+"""The sidebar panels drawn into a recording stand-in layout, and adding and removing views."""
+
+import types
+
+import cv2
+import numpy as np
+import pytest
+
+
+class Recorder:
+    """Stands in for a UILayout: records what is drawn, and sub-layouts record into it too."""
+
+    def __init__(self, calls=None):
+        self.calls = [] if calls is None else calls
+
+    def __getattr__(self, name):
+        if name in ("row", "column", "box", "split", "grid_flow", "column_flow"):
+            return lambda *a, **k: Recorder(self.calls)
+        return lambda *a, **k: self.calls.append((name, a, k))
+
+    def __setattr__(self, name, value):
+        if name == "calls":
+            object.__setattr__(self, name, value)
+
+
+def _draw(bpy, panel_cls):
+    rec = Recorder()
+    panel_cls.draw(types.SimpleNamespace(layout=rec), bpy.context)
+    return rec.calls
+
+
+def test_panels_draw_existing_properties_and_operators(bpy_module, registered, tmp_path):
+    bpy = bpy_module
+    panels = registered.twist_addon.panels
+    png = tmp_path / "f_0001.png"
+    cv2.imwrite(str(png), np.zeros((36, 48, 3), np.uint8))
+    bpy.ops.twist.add_view(filepath=str(png))
+    bpy.context.scene.twist.result.diverged_frames = "12 (the body left the image of view 1)"
+    drawn_props, drawn_ops = set(), set()
+    for cls in panels.CLASSES:
+        if not issubclass(cls, bpy.types.Panel):
+            continue
+        assert cls.poll(bpy.context) if hasattr(cls, "poll") else True
+        for name, args, kw in _draw(bpy, cls):
+            if name == "prop":
+                data, prop = args[0], args[1]
+                assert prop in data.bl_rna.properties, (cls.__name__, prop)
+                assert data.bl_rna.properties[prop].description, (cls.__name__, prop)
+                drawn_props.add(prop)
+            elif name in ("operator", "operator_menu_enum"):
+                op = args[0]
+                mod, fn = op.split(".")
+                rna = getattr(getattr(bpy.ops, mod), fn).get_rna_type()
+                assert rna.description, op
+                drawn_ops.add(op)
+            elif name == "template_list":
+                assert args[0] == "TWIST_UL_views"
+                assert args[3] in args[2].bl_rna.properties
+    assert {"armature", "mode", "direction", "levels", "stop_on_divergence",
+            "frames_tracked", "first_frame"} <= drawn_props
+    assert {"twist.track", "twist.clear_track", "twist.add_view", "twist.remove_view",
+            "twist.add_template_armature"} <= drawn_ops
+
+
+def test_add_and_remove_views(bpy_module, registered, tmp_path):
+    bpy = bpy_module
+    for i in range(4):
+        cv2.imwrite(str(tmp_path / f"side_{i:04d}.png"), np.full((30, 40, 3), 50 * i, np.uint8))
+    scene = bpy.context.scene
+    assert bpy.ops.twist.add_view(filepath=str(tmp_path / "side_0002.png"),
+                                  first_frame=5) == {"FINISHED"}
+    view = scene.twist.views[0]
+    assert view.camera.data.type == "ORTHO" and view.first_frame == 5
+    bg = view.camera.data.background_images[0]
+    assert bg.image.source == "SEQUENCE" and bg.image_user.frame_duration == 4
+    assert (scene.render.resolution_x, scene.render.resolution_y) == (40, 30)
+    assert view.images.endswith("*.png")
+    with pytest.raises(RuntimeError, match="no such image file"):
+        bpy.ops.twist.add_view(filepath=str(tmp_path / "missing.png"))
+    assert bpy.ops.twist.remove_view() == {"FINISHED"}
+    assert len(scene.twist.views) == 0 and "View 1" in bpy.data.objects

@@ -1,0 +1,100 @@
+"""The sidebar tab in the 3D viewport, in the order of the work: footage and views, armature,
+track (settings folded away), results."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import bpy
+
+from ..core.tracker import TrackerSettings
+
+_MAIN_SETTINGS = ("levels", "iterations", "key_weight")
+
+
+class TWIST_UL_views(bpy.types.UIList):
+    """One row per view: its camera and footage."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname):
+        row = layout.row(align=True)
+        row.prop(item, "camera", text="", icon="CAMERA_DATA")
+        row.prop(item, "images", text="")
+
+
+class _TwistPanel:
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Twist Mocap"
+
+
+class TWIST_PT_views(_TwistPanel, bpy.types.Panel):
+    bl_label = "Footage & Views"
+
+    def draw(self, context):
+        tw = context.scene.twist
+        layout = self.layout
+        row = layout.row()
+        row.template_list("TWIST_UL_views", "", tw, "views", tw, "active_view", rows=3)
+        col = row.column(align=True)
+        col.operator("twist.add_view", icon="ADD", text="")
+        col.operator("twist.remove_view", icon="REMOVE", text="")
+        if tw.views:
+            view = tw.views[tw.active_view]
+            layout.prop(view, "first_frame")
+        layout.prop(tw, "mode")
+
+
+class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
+    bl_label = "Armature"
+
+    def draw(self, context):
+        tw = context.scene.twist
+        layout = self.layout
+        layout.prop(tw, "armature")
+        layout.operator_menu_enum("twist.add_template_armature", "template", icon="ARMATURE_DATA")
+
+
+class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
+    bl_label = "Track"
+
+    def draw(self, context):
+        tw = context.scene.twist
+        layout = self.layout
+        layout.prop(tw, "direction", expand=True)
+        row = layout.row(align=True)
+        row.scale_y = 1.4
+        row.operator("twist.track", icon="TRACKING")
+        layout.operator("twist.clear_track", icon="X")
+
+
+class TWIST_PT_track_settings(_TwistPanel, bpy.types.Panel):
+    bl_label = "Settings"
+    bl_parent_id = "TWIST_PT_track"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        settings = context.scene.twist.tracker
+        layout = self.layout
+        layout.use_property_split = True
+        for name in _MAIN_SETTINGS:
+            layout.prop(settings, name)
+        col = layout.column(heading="Advanced")
+        for f in dataclasses.fields(TrackerSettings):
+            if f.name not in _MAIN_SETTINGS:
+                col.prop(settings, f.name)
+
+
+class TWIST_PT_results(_TwistPanel, bpy.types.Panel):
+    bl_label = "Results"
+
+    def draw(self, context):
+        result = context.scene.twist.result
+        layout = self.layout
+        layout.prop(result, "frames_tracked")
+        layout.prop(result, "last_residual")
+        if result.diverged_frames:
+            layout.label(text="Stopped at frame " + result.diverged_frames, icon="ERROR")
+
+
+CLASSES = (TWIST_UL_views, TWIST_PT_views, TWIST_PT_armature, TWIST_PT_track,
+           TWIST_PT_track_settings, TWIST_PT_results)
