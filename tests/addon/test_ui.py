@@ -41,7 +41,7 @@ def test_panels_draw_existing_properties_and_operators(bpy_module, registered, t
         if not issubclass(cls, bpy.types.Panel):
             continue
         assert cls.poll(bpy.context) if hasattr(cls, "poll") else True
-        for name, args, kw in _draw(bpy, cls):
+        for name, args, _ in _draw(bpy, cls):
             if name == "prop":
                 data, prop = args[0], args[1]
                 assert prop in data.bl_rna.properties, (cls.__name__, prop)
