@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import operators, panels, properties
+from . import operators, overlay, panels, properties
 
-MODULES = (properties, operators, panels)
+MODULES = (properties, operators, panels, overlay)
 
 
 def register():

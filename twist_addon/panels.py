@@ -51,6 +51,7 @@ class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
         tw = context.scene.twist
         layout = self.layout
         layout.prop(tw, "armature")
+        layout.prop(tw, "show_overlay")
         layout.operator_menu_enum("twist.add_template_armature", "template", icon="ARMATURE_DATA")
 
 

@@ -98,6 +98,10 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
     views: bpy.props.CollectionProperty(type=TWIST_PG_view)
     active_view: bpy.props.IntProperty(name="Active View", description="The selected view")
     result: bpy.props.PointerProperty(type=TWIST_PG_result)
+    show_overlay: bpy.props.BoolProperty(
+        name="Show Blobs", default=True,
+        description="Draw the outline of every blob over the viewport, to line the armature up "
+                    "with the footage through each view's camera")
     direction: bpy.props.EnumProperty(
         name="Direction", default="FORWARD",
         description="Which way to track from the current frame",

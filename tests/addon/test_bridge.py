@@ -163,3 +163,28 @@ def test_template_armatures_come_back_as_their_skeletons(bpy_module, registered,
     cj, ca = core_sk.dof_joints_and_axes()
     hinge = [k for k, j in enumerate(cj) if core_sk.kinds[j] == "hinge"]
     np.testing.assert_allclose(np.abs(da[hinge]), np.abs(ca[hinge] @ T.T), atol=1e-6)
+
+
+def test_overlay_outlines_lie_on_the_projected_blobs(bpy_module, registered):
+    from core import raycast
+    from core.camera import View
+    from core.se3 import Similarity, exp_so3
+    from core.skeleton import human_template
+
+    overlay = registered.twist_addon.overlay
+    sk = human_template()
+    rng = np.random.default_rng(3)
+    R = np.array([exp_so3(rng.normal(0, 0.3, 3)) for _ in range(sk.n_joints)])
+    cam_R = exp_so3(np.array([0.2, 1.0, -0.1]))
+    view = View(Similarity(200.0, cam_R, np.array([0, 0, 5.0])), np.array([200.0, 200.0]))
+    loops = overlay.silhouette_loops(sk, R, sk.rest_positions[0], cam_R[2])
+    g = sk.segment_motions(sk.joint_frames(R, sk.rest_positions[0]))
+    A, C = raycast.blob_frames(sk.blobs, g)
+    for i, loop in enumerate(loops):
+        y = (loop - C[i]) @ A[i].T  # on the blob's surface ...
+        np.testing.assert_allclose(np.linalg.norm(y, axis=1), 1.0, atol=1e-9)
+        pix = view.project(loop)  # ... and on its outline: half a pixel in hits, out misses
+        centre = view.project(C[i])
+        inward = (centre - pix) / np.linalg.norm(centre - pix, axis=1, keepdims=True)
+        assert np.all(raycast.cast(view, pix + 0.5 * inward, [sk.blobs[i]], g).label == 0)
+        assert np.all(raycast.cast(view, pix - 0.5 * inward, [sk.blobs[i]], g).label == -1)
