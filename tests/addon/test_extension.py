@@ -92,3 +92,27 @@ def test_scene_settings_mirror_the_core_tracker_settings(installed):
     assert all(len(t) > 15 for t in out["tooltips"].values()), out["tooltips"]
     assert out["changed"] == [2, 0.25, False]
     assert out["mode"] == "CALIBRATED"
+
+
+def test_track_runs_through_the_installed_extension(installed, tmp_path):
+    sys.path.insert(0, str(ROOT / "bench"))
+    from walk_footage import render
+
+    render(tmp_path, 560, 568, 4, ["lateral"])  # three frames, one view
+    env, _ = installed
+    out = _in_blender(env, f"""
+        import sys
+        sys.path[:0] = [{str(ROOT / "bench")!r}, {str(ROOT / "tests")!r}]
+        from pathlib import Path
+        from support.walk_scene import walk_scene
+        scene, arm = walk_scene(bpy, Path({str(tmp_path)!r}), ["lateral"], 3)
+        out["result"] = sorted(bpy.ops.twist.track())
+        bag = arm.animation_data.action.layers[0].strips[0].channelbag(arm.animation_data.action_slot)
+        out["keys"] = sorted({{(int(k.co[0]), k.type) for fc in bag.fcurves
+                              for k in fc.keyframe_points}})
+        out["tracked"] = scene.twist.result.frames_tracked
+    """)
+    assert out["result"] == ["FINISHED"]
+    assert out["keys"] == [[2, "GENERATED"], [3, "GENERATED"]]
+    assert out["tracked"] == 2
+

@@ -10,13 +10,13 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "bench"))
 
-from walk_footage import BLOBS, JOINTS, add_camera, camera_rotations, render  # noqa: E402
+from walk_footage import render  # noqa: E402
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
+from support.walk_scene import TRACKED, walk_scene  # noqa: E402
 
 VIEWS = ["lateral", "endon", "oblique60"]
-TRACKED = [name for name in JOINTS]  # balls here: Blender's bone axes are not the capture's
 
 
 @pytest.fixture(scope="module")
@@ -27,32 +27,8 @@ def footage(tmp_path_factory):
 
 
 def _scene(bpy, addon, folder: Path):
-    """Factory scene, add-on registered, armature posed on frame 1, cameras and views."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.import_anim.bvh(filepath=str(folder / "truth.bvh"), axis_forward="Y", axis_up="Z",
-                            frame_start=1)
-    arm = bpy.context.selected_objects[0]
-    scene = bpy.context.scene
-    scene.frame_set(1)
-    arm.animation_data_clear()  # the pose of frame 1 stays: the user's initial pose
-    for pb in arm.pose.bones:
-        pb.lock_rotation = (pb.name not in TRACKED,) * 3
-    bpy.context.view_layer.objects.active = arm
-    bpy.ops.object.mode_set(mode="EDIT")
-    for eb in arm.data.edit_bones:
-        spec = BLOBS.get(eb.name, {"radius": 0.0})
-        r = 0.0 if spec is False else float(np.mean(spec.get("radii", [spec.get("radius")])))
-        eb.head_radius = eb.tail_radius = r
-    bpy.ops.object.mode_set(mode="OBJECT")
-    scene.render.resolution_x, scene.render.resolution_y = 480, 360
-    scene.frame_start, scene.frame_end = 1, 6
-    scene.twist.armature = arm
-    for v, R in camera_rotations().items():
-        cam = add_camera(bpy, v, R)
-        view = scene.twist.views.add()
-        view.camera, view.images, view.first_frame = cam, str(folder / v / "*.png"), 1
-    scene.frame_set(1)
-    return scene, arm
+    return walk_scene(bpy, folder, VIEWS, 6)
 
 
 def _channel_frames(arm):
