@@ -107,7 +107,8 @@ def test_track_runs_through_the_installed_extension(installed, tmp_path):
         from support.walk_scene import walk_scene
         scene, arm = walk_scene(bpy, Path({str(tmp_path)!r}), ["lateral"], 3)
         out["result"] = sorted(bpy.ops.twist.track())
-        bag = arm.animation_data.action.layers[0].strips[0].channelbag(arm.animation_data.action_slot)
+        ad = arm.animation_data
+        bag = ad.action.layers[0].strips[0].channelbag(ad.action_slot)
         out["keys"] = sorted({{(int(k.co[0]), k.type) for fc in bag.fcurves
                               for k in fc.keyframe_points}})
         out["tracked"] = scene.twist.result.frames_tracked
