@@ -14,15 +14,15 @@ $(STAMP): requirements.txt
 	$(PY) -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 
-# Track the bundled example (rendered walk, three views) from the command line.
+# Track the bundled example through the add-on: tracked .blend, BVH, FBX, contact sheet.
 demo: venv
-	$(PY) bench/demo.py
+	$(PY) scripts/demo.py
 
 test: venv
 	$(PY) -m pytest
 
 lint: venv
-	$(VENV)/bin/ruff check core twist_addon bench tests scripts
+	$(VENV)/bin/ruff check core twist_addon bench tests scripts example_blends
 
 # The tracking benchmark (renders its footage once into .cache/, ~10 minutes).
 bench: venv

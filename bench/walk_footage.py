@@ -14,6 +14,7 @@ cameras and the ground truth need no conversion. Run with the project's virtual 
 
 Writes OUT/<view>/NNNN.png, OUT/truth.bvh (the capture's frames that were rendered, the
 ground truth) and OUT/cameras.json. Frames already rendered with the same settings are kept.
+``write_job`` writes a tracking job for such footage, ``tracking_scene`` a Blender scene.
 """
 
 from __future__ import annotations
@@ -299,6 +300,40 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
     cams_json = {v: job_camera(rots[v]) for v in views}
     (out / "cameras.json").write_text(json.dumps(cams_json, indent=1))
     return {"frames": frames, "cameras": cams_json, "rendered": len(todo)}
+
+
+def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images: str = "*.png"):
+    """Make the current scene ready to track rendered walk footage in ``folder``: the capture
+    (folder/truth.bvh) imported as an armature and posed on frame 1, the tracked bones
+    unlocked (as balls: Blender's bone axes are not the capture's hinge axes), envelope radii
+    from BLOBS, one orthographic camera and view per rendered view, frames 1..last_frame.
+    Needs the add-on registered; resetting the scene is the caller's (a factory reset disables
+    an installed extension)."""
+    bpy.ops.import_anim.bvh(filepath=str(folder / "truth.bvh"), axis_forward="Y", axis_up="Z",
+                            frame_start=1)
+    arm = bpy.context.view_layer.objects.active
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    arm.animation_data_clear()  # the pose of frame 1 stays: the user's initial pose
+    for pb in arm.pose.bones:
+        pb.lock_rotation = (pb.name not in JOINTS,) * 3
+    bpy.context.view_layer.objects.active = arm
+    bpy.ops.object.mode_set(mode="EDIT")
+    for eb in arm.data.edit_bones:
+        spec = BLOBS.get(eb.name, {"radius": 0.0})
+        r = 0.0 if spec is False else float(np.mean(spec.get("radii", [spec.get("radius")])))
+        eb.head_radius = eb.tail_radius = r
+    bpy.ops.object.mode_set(mode="OBJECT")
+    scene.render.resolution_x, scene.render.resolution_y = 480, 360
+    scene.frame_start, scene.frame_end = 1, last_frame
+    scene.twist.armature = arm
+    rotations = camera_rotations()
+    for v in views:
+        cam = add_camera(bpy, v, rotations[v])
+        view = scene.twist.views.add()
+        view.camera, view.images, view.first_frame = cam, str(folder / v / images), 1
+    scene.frame_set(1)
+    return scene, arm
 
 
 def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list[int],

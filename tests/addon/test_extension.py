@@ -102,10 +102,10 @@ def test_track_runs_through_the_installed_extension(installed, tmp_path):
     env, _ = installed
     out = _in_blender(env, f"""
         import sys
-        sys.path[:0] = [{str(ROOT / "bench")!r}, {str(ROOT / "tests")!r}]
+        sys.path.insert(0, {str(ROOT / "bench")!r})
         from pathlib import Path
-        from support.walk_scene import walk_scene
-        scene, arm = walk_scene(bpy, Path({str(tmp_path)!r}), ["lateral"], 3)
+        from walk_footage import tracking_scene
+        scene, arm = tracking_scene(bpy, Path({str(tmp_path)!r}), ["lateral"], 3)
         out["result"] = sorted(bpy.ops.twist.track())
         ad = arm.animation_data
         bag = ad.action.layers[0].strips[0].channelbag(ad.action_slot)

@@ -10,13 +10,13 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "bench"))
 
-from walk_footage import render  # noqa: E402
+from walk_footage import JOINTS, render, tracking_scene  # noqa: E402
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
-from support.walk_scene import TRACKED, walk_scene  # noqa: E402
 
 VIEWS = ["lateral", "endon", "oblique60"]
+TRACKED = list(JOINTS)
 
 
 @pytest.fixture(scope="module")
@@ -28,7 +28,7 @@ def footage(tmp_path_factory):
 
 def _scene(bpy, addon, folder: Path):
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    return walk_scene(bpy, folder, VIEWS, 6)
+    return tracking_scene(bpy, folder, VIEWS, 6)
 
 
 def _channel_frames(arm):

@@ -1,0 +1,77 @@
+"""Build the example scenes in this folder (run from the repository with its virtual
+environment): ``python example_blends/build_examples.py``.
+
+walk_3view.blend: three orthographic views of the CMU walk, rendered by bench/walk_footage.py
+(one second of steady walking at 15 frames per second, JPEG frames in walk_3view/), the
+capture's armature posed on frame 1, ready for Track. Paths are relative to the .blend, so the
+folder can move. The capture's frames that were rendered are kept as walk_3view/truth.bvh.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import cv2
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+from walk_footage import render, tracking_scene  # noqa: E402
+
+WALK = dict(first=540, last=660, step=8)  # capture frames: one second at 15 fps
+VIEWS = ["lateral", "endon", "oblique60"]
+
+
+def load_addon():
+    """Register the add-on from this repository, imported as Blender imports the extension."""
+    if "twist_mocap" not in sys.modules:
+        spec = importlib.util.spec_from_file_location(
+            "twist_mocap", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)])
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["twist_mocap"] = module
+        spec.loader.exec_module(module)
+    return sys.modules["twist_mocap"]
+
+
+def build_walk(bpy) -> Path:
+    out = HERE / "walk_3view"
+    with tempfile.TemporaryDirectory() as tmp:
+        info = render(Path(tmp), WALK["first"], WALK["last"], WALK["step"], VIEWS)
+        if out.exists():
+            shutil.rmtree(out)
+        for v in VIEWS:
+            (out / v).mkdir(parents=True)
+            for i, f in enumerate(info["frames"]):
+                img = cv2.imread(str(Path(tmp) / v / f"{f:04d}.png"))
+                cv2.imwrite(str(out / v / f"{i + 1:04d}.jpg"), img,
+                            [cv2.IMWRITE_JPEG_QUALITY, 92])
+        shutil.copy(Path(tmp) / "truth.bvh", out / "truth.bvh")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon = load_addon()
+    addon.register()
+    path = HERE / "walk_3view.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))  # so that // paths mean this folder
+    scene, arm = tracking_scene(bpy, out, VIEWS, len(info["frames"]), "*.jpg")
+    for view in scene.twist.views:
+        view.images = bpy.path.relpath(view.images)
+    scene.render.fps = 15
+    scene.camera = scene.twist.views[0].camera
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), relative_remap=True)
+    return path
+
+
+def main() -> int:
+    import bpy
+
+    print(build_walk(bpy))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
