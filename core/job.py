@@ -16,6 +16,7 @@ never removed or changed in meaning. Relative paths are relative to the job file
      "settings": {"levels": 3},
      "frame_time": 0.0667}
 
+A view's ``images`` are a glob, a list of image files or one movie file (.mp4, .mov, .avi...).
 A camera maps a world point X (the BVH's units) to pixel = scale * (R X + t)[:2] + center,
 x right, y down. Joints not named under ``joints`` keep their initial rotation. A blob entry
 sets the short radius (``radius``, or two ``radii``) and optionally the full ``length`` along
@@ -35,9 +36,11 @@ import numpy as np
 from . import se3
 from .bvh import BvhError, BvhFile, read_bvh
 from .camera import View
+from .image import ImageError
 from .pose import CALIBRATED, INDEPENDENT, BodyPose
 from .skeleton import BALL, FIXED, HINGE, Skeleton, skeleton_from_bvh
 from .tracker import TrackerSettings
+from .video import VideoFrames, is_video
 
 
 class JobError(ValueError):
@@ -49,7 +52,7 @@ class Job:
     skeleton: Skeleton
     bvh: BvhFile  # the skeleton's BVH: hierarchy and channel layout of the output
     initial: BodyPose
-    images: list[list[str]]  # per view, per frame
+    images: list  # per view, per frame: image paths, or a movie's VideoFrames
     cameras: list[View]  # the cameras as given (the initial pose's views start as copies)
     mode: str
     settings: TrackerSettings
@@ -98,7 +101,15 @@ def parse_camera(d, where: str) -> View:
     return View(se3.Similarity(scale, R, t), center)
 
 
-def _images(spec, base: Path, where: str) -> list[str]:
+def _images(spec, base: Path, where: str):
+    if isinstance(spec, str) and is_video(spec):
+        path = base / spec
+        if not path.is_file():
+            raise JobError(f"{where}: the movie '{spec}' is not found (relative to {base})")
+        try:
+            return VideoFrames(path)
+        except ImageError as e:
+            raise JobError(f"{where}: {e}") from None
     if isinstance(spec, str):
         paths = sorted(glob.glob(str(base / spec)))
         if not paths:
@@ -110,7 +121,7 @@ def _images(spec, base: Path, where: str) -> list[str]:
         if missing:
             raise JobError(f"{where}: {len(missing)} image(s) not found, first: {missing[0]}")
         return paths
-    raise JobError(f"{where}: expected a glob pattern or a list of image paths")
+    raise JobError(f"{where}: expected a movie file, a glob pattern or a list of image paths")
 
 
 def _apply_joints(sk: Skeleton, spec, where: str) -> None:

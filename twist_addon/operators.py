@@ -14,6 +14,7 @@ import bpy
 
 from ..core.image import ImageError
 from ..core.job import JobError
+from ..core.video import is_video
 from .bridge import BridgeError, armature_from_skeleton, skeleton_from_armature
 from .keyframes import clear
 from .track import TrackSession
@@ -180,8 +181,8 @@ class TWIST_OT_add_view(bpy.types.Operator):
 
     filepath: bpy.props.StringProperty(
         name="Footage", subtype="FILE_PATH",
-        description="Any image of the footage; its folder's images of the same kind are read "
-                    "in name order")
+        description="A movie, or any image of the footage: its folder's images of the same "
+                    "kind are read in name order")
     first_frame: bpy.props.IntProperty(
         name="First Frame", default=1,
         description="The scene frame that shows the footage's first image")
@@ -193,10 +194,10 @@ class TWIST_OT_add_view(bpy.types.Operator):
     def execute(self, context):
         path = Path(bpy.path.abspath(self.filepath))
         if not path.is_file():
-            self.report({"ERROR"}, f"{self.filepath}: no such image file")
+            self.report({"ERROR"}, f"{self.filepath}: no such image or movie file")
             return {"CANCELLED"}
-        pattern = str(path.parent / f"*{path.suffix}")
-        count = len(glob.glob(pattern))
+        movie = is_video(path)
+        pattern = str(path) if movie else str(path.parent / f"*{path.suffix}")
         scene = context.scene
         n = len(scene.twist.views) + 1
         cam_data = bpy.data.cameras.new(f"View {n}")
@@ -206,14 +207,21 @@ class TWIST_OT_add_view(bpy.types.Operator):
         context.collection.objects.link(cam)
         cam.location = (0.0, -10.0, 1.0)
         cam.rotation_euler = (1.5707963, 0.0, 0.0)  # looking along +y, z up: a side view
-        image = bpy.data.images.load(str(path), check_existing=True)
-        image.source = "SEQUENCE" if count > 1 else "FILE"
         bg = cam_data.background_images.new()
-        bg.image = image
-        bg.image_user.frame_start = self.first_frame
-        bg.image_user.frame_duration = count
         bg.frame_method = "FIT"
-        img_w, img_h = image.size
+        if movie:
+            clip = bpy.data.movieclips.load(str(path), check_existing=True)
+            clip.frame_start = self.first_frame
+            bg.source, bg.clip = "MOVIE_CLIP", clip
+            count, (img_w, img_h) = clip.frame_duration, clip.size
+        else:
+            count = len(glob.glob(pattern))
+            image = bpy.data.images.load(str(path), check_existing=True)
+            image.source = "SEQUENCE" if count > 1 else "FILE"
+            bg.image = image
+            bg.image_user.frame_start = self.first_frame
+            bg.image_user.frame_duration = count
+            img_w, img_h = image.size
         if img_w and img_h and n == 1:
             scene.render.resolution_x, scene.render.resolution_y = img_w, img_h
         view = scene.twist.views.add()
@@ -221,7 +229,7 @@ class TWIST_OT_add_view(bpy.types.Operator):
         view.images = bpy.path.relpath(pattern) if bpy.data.filepath else pattern
         view.first_frame = self.first_frame
         scene.twist.active_view = len(scene.twist.views) - 1
-        self.report({"INFO"}, f"added '{cam.name}' with {count} images")
+        self.report({"INFO"}, f"added '{cam.name}' with {count} frames")
         return {"FINISHED"}
 
 

@@ -12,30 +12,34 @@ import bpy
 from ..core.job import world_root
 from ..core.pose import BodyPose
 from ..core.tracker import FrameResult, Tracker
+from ..core.video import VideoFrames, is_video
 from . import keyframes
 from .bridge import BridgeError, pose_from_armature, skeleton_from_armature, view_from_camera
 from .properties import settings_from_properties
 
 
-def footage_frames(view_pg, frames: list[int]) -> list[str]:
-    """The image file of every scene frame in ``frames`` for one view; BridgeError names the
-    view and the first frame without an image."""
+def footage_frames(view_pg, frames: list[int]) -> list:
+    """The image (file, or decoded movie frame) of every scene frame in ``frames`` for one
+    view; BridgeError names the view and the first frame without an image."""
     cam = view_pg.camera.name if view_pg.camera else "(no camera)"
     if not view_pg.images:
         raise BridgeError(f"the view of '{cam}' has no footage; set its images")
-    paths = sorted(glob.glob(bpy.path.abspath(view_pg.images)))
-    if not paths:
+    source = bpy.path.abspath(view_pg.images)
+    paths = VideoFrames(source) if is_video(source) else sorted(glob.glob(source))
+    if not len(paths):
         raise BridgeError(f"the footage of the view of '{cam}' ({view_pg.images}) matches no "
                           "file")
-    out = []
+    indices = []
     for f in frames:
         i = f - view_pg.first_frame
         if not 0 <= i < len(paths):
             raise BridgeError(f"the view of '{cam}' has no image for frame {f} (its "
                               f"{len(paths)} images cover frames {view_pg.first_frame}-"
                               f"{view_pg.first_frame + len(paths) - 1})")
-        out.append(paths[i])
-    return out
+        indices.append(i)
+    if isinstance(paths, list):
+        return [paths[i] for i in indices]
+    return paths.select(indices)
 
 
 @dataclass

@@ -75,7 +75,29 @@ def test_add_and_remove_views(bpy_module, registered, tmp_path):
     assert bg.image.source == "SEQUENCE" and bg.image_user.frame_duration == 4
     assert (scene.render.resolution_x, scene.render.resolution_y) == (40, 30)
     assert view.images.endswith("*.png")
-    with pytest.raises(RuntimeError, match="no such image file"):
+    with pytest.raises(RuntimeError, match="missing.png: no such image or movie file"):
         bpy.ops.twist.add_view(filepath=str(tmp_path / "missing.png"))
     assert bpy.ops.twist.remove_view() == {"FINISHED"}
     assert len(scene.twist.views) == 0 and "View 1" in bpy.data.objects
+
+
+def test_a_movie_becomes_a_view_with_the_clip_behind_its_camera(bpy_module, registered,
+                                                                 tmp_path):
+    bpy = bpy_module
+    movie = tmp_path / "walk.avi"
+    writer = cv2.VideoWriter(str(movie), cv2.VideoWriter_fourcc(*"MJPG"), 15, (64, 48))
+    for i in range(6):
+        writer.write(np.full((48, 64, 3), 30 * i, np.uint8))
+    writer.release()
+    assert bpy.ops.twist.add_view(filepath=str(movie), first_frame=3) == {"FINISHED"}
+    scene = bpy.context.scene
+    view = scene.twist.views[0]
+    bg = view.camera.data.background_images[0]
+    assert bg.source == "MOVIE_CLIP" and bg.clip.frame_duration == 6
+    assert (scene.render.resolution_x, scene.render.resolution_y) == (64, 48)
+    track = registered.twist_addon.track
+    frames = track.footage_frames(view, [4, 8, 3])
+    assert len(frames) == 3
+    assert [int(round(frames[k].mean() / 30)) for k in range(3)] == [1, 5, 0]
+    with pytest.raises(registered.twist_addon.bridge.BridgeError, match="no image for frame 9"):
+        track.footage_frames(view, [9])

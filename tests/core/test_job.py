@@ -139,3 +139,35 @@ def test_camera_parsing_maps_world_points_as_documented():
     R, t = np.array(CAMERA["R"], float), np.array(CAMERA["t"])
     expect = 150 * (R @ X + t)[:2] + np.array(CAMERA["center"])
     np.testing.assert_allclose(view.project(X), expect)
+
+
+def test_a_movie_is_footage_like_its_frames(footage, tmp_path):
+    folder, job = footage
+    frames = sorted((folder / "side").glob("*.png"))
+    movie = folder / "side.avi"  # Motion-JPEG: lossy, so compared within a few grey levels
+    first = cv2.imread(str(frames[0]))
+    writer = cv2.VideoWriter(str(movie), cv2.VideoWriter_fourcc(*"MJPG"), 30,
+                             (first.shape[1], first.shape[0]))
+    for f in frames:
+        writer.write(cv2.imread(str(f)))
+    writer.release()
+    from core.video import VideoFrames
+
+    video = VideoFrames(movie)
+    assert len(video) == 3
+    for i in (2, 0, 1):  # a seek back, then forward
+        diff = np.abs(video[i].astype(int) - cv2.imread(str(frames[i])).astype(int))
+        assert diff.mean() < 3
+    bad = dict(job, views=[dict(job["views"][0], images="side.avi"),
+                           dict(job["views"][1], images="nowhere.mp4")])
+    path = folder / "job_movie.json"
+    path.write_text(json.dumps(bad))
+    with pytest.raises(JobError, match=r"views\[1\].images: the movie 'nowhere.mp4' is not"):
+        load_job(path)
+    ok = dict(job, views=job["views"][:1], settings={"levels": 2})
+    ok["views"] = [dict(job["views"][0], images="side.avi")]
+    path.write_text(json.dumps(ok))
+    out = tmp_path / "movie.bvh"
+    proc = _run("track", path, "--out", out, "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert len(read_bvh(out).motion) == 3
