@@ -353,7 +353,7 @@ class Tracker:
                     est, kin, smp = cand, kin_c, c_smp
                     offset = offset + delta
                     lam = max(lam / 3, 1e-6)
-                    if moved / 2**lv < s.converge_pixels or old - new < 1e-4 * old:
+                    if moved / 2**lv < s.converge_pixels:
                         converged = True
                         break
                     ne = self._normal_equations(kin, sets, smp, sigmas)
