@@ -1,17 +1,22 @@
-"""Command line: ``python -m core track JOB.json --out TRACKED.bvh [--report REPORT.json]``.
+"""Command line:
 
-Exit status: 0 tracked every frame; 2 the job is malformed (nothing tracked); 3 tracking
-stopped at a diverged frame (the frames before it are written).
+    python -m core track JOB.json --out TRACKED.bvh [--report REPORT.json]
+    python -m core fit FIT.json --out FITTED.bvh
+
+Exit status: 0 done; 2 the job is malformed or the clicks cannot determine a fit (nothing
+written); 3 tracking stopped at a diverged frame (the frames before it are written).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 
 from .bvh import write_bvh
 from .image import ImageError
-from .job import JobError, load_job
+from .init_fit import FitError, fit_pose
+from .job import JobError, load_fit, load_job, world_root
 from .run import report, result_bvh, timed_run, write_report
 
 
@@ -47,6 +52,24 @@ def _track(args) -> int:
     return 0
 
 
+def _fit(args) -> int:
+    try:
+        job = load_fit(args.job)
+        res = fit_pose(job.skeleton, job.guess, job.clicks, job.mode)
+    except (JobError, FitError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    R = res.pose.rotations.copy()
+    R[0], root = world_root(job.mode, job.cameras[0], res.pose)
+    out = job.bvh.with_motion(R[None], root[None])
+    out.joints = [dataclasses.replace(j, offset=o) for j, o in zip(out.joints,
+                                                                   res.skeleton.offsets)]
+    write_bvh(out, args.out)
+    print(f"fitted {sum(len(c) for c in job.clicks)} clicks, {res.residual_px:.2f} px RMS"
+          f" -> {args.out}", file=sys.stderr)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m core", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -55,10 +78,11 @@ def main(argv=None) -> int:
     t.add_argument("--out", required=True, help="the tracked BVH to write")
     t.add_argument("--report", help="a JSON report of every frame to write")
     t.add_argument("--quiet", action="store_true", help="no per-frame progress")
+    f = sub.add_parser("fit", help="fit the first pose and body proportions to clicked joints")
+    f.add_argument("job", help="the fit file (JSON)")
+    f.add_argument("--out", required=True, help="the BVH to write: fitted offsets, one frame")
     args = ap.parse_args(argv)
-    if args.command == "track":
-        return _track(args)
-    return 2
+    return _track(args) if args.command == "track" else _fit(args)
 
 
 if __name__ == "__main__":

@@ -203,20 +203,20 @@ def initial_pose(sk: Skeleton, bvh: BvhFile, frame: int, cameras: list[View]) ->
     return BodyPose(R, root, [c.copy() for c in cameras])
 
 
-def load_job(path: str | Path) -> Job:
-    """Read and validate a job file; raises JobError naming the first bad field."""
-    path = Path(path)
+def _read_json(path: Path, what: str) -> dict:
     try:
         d = json.loads(path.read_text())
     except OSError as e:
-        raise JobError(f"{path}: cannot read the job file ({e.strerror})") from None
+        raise JobError(f"{path}: cannot read the {what} ({e.strerror})") from None
     except json.JSONDecodeError as e:
         raise JobError(f"{path}: not valid JSON (line {e.lineno}: {e.msg})") from None
-    base = path.parent
-    where = path.name
     if not isinstance(d, dict):
-        raise JobError(f"{where}: expected a JSON object")
+        raise JobError(f"{path.name}: expected a JSON object")
+    return d
 
+
+def _body(d: dict, base: Path, where: str) -> tuple[Skeleton, BvhFile, BvhFile, int]:
+    """The ``skeleton`` and ``initial`` fields: skeleton, its BVH, the initial BVH and frame."""
     sk_spec = _field(d, "skeleton", where, dict)
     bvh_path = base / _field(sk_spec, "bvh", f"{where}.skeleton", str)
     try:
@@ -228,7 +228,6 @@ def load_job(path: str | Path) -> Job:
     sk.blobs = sk.default_blobs()
     if "blobs" in sk_spec:
         _apply_blobs(sk, sk_spec["blobs"], f"{where}.skeleton.blobs")
-
     init = _field(d, "initial", where, dict)
     init_path = base / _field(init, "bvh", f"{where}.initial", str)
     frame = _field(init, "frame", f"{where}.initial", int) if "frame" in init else 0
@@ -242,7 +241,22 @@ def load_job(path: str | Path) -> Job:
         raise JobError(
             f"{where}.initial.frame: {frame} is outside 0..{len(init_bvh.motion) - 1}"
         )
+    return sk, bvh, init_bvh, frame
 
+
+def _mode(d: dict, where: str) -> str:
+    mode = d.get("mode", INDEPENDENT)
+    if mode not in (CALIBRATED, INDEPENDENT):
+        raise JobError(f"{where}.mode: expected 'calibrated' or 'independent', got {mode!r}")
+    return mode
+
+
+def load_job(path: str | Path) -> Job:
+    """Read and validate a job file; raises JobError naming the first bad field."""
+    path = Path(path)
+    d = _read_json(path, "job file")
+    base, where = path.parent, path.name
+    sk, bvh, init_bvh, frame = _body(d, base, where)
     views = _field(d, "views", where, list)
     if not views:
         raise JobError(f"{where}.views: expected at least one view")
@@ -257,16 +271,55 @@ def load_job(path: str | Path) -> Job:
                        + ", ".join(str(len(x)) for x in images))
     if min(counts) < 2:
         raise JobError(f"{where}.views: at least two frames are needed to track")
-
-    mode = d.get("mode", INDEPENDENT)
-    if mode not in (CALIBRATED, INDEPENDENT):
-        raise JobError(f"{where}.mode: expected 'calibrated' or 'independent', got {mode!r}")
+    mode = _mode(d, where)
     settings = _settings(d.get("settings"), f"{where}.settings")
     ft = d.get("frame_time", bvh.frame_time)
     if not isinstance(ft, (int, float)) or ft <= 0:
         raise JobError(f"{where}.frame_time: expected seconds per frame > 0, got {ft!r}")
     pose = initial_pose(sk, init_bvh, frame, cameras)
     return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft))
+
+
+@dataclass
+class FitJob:
+    """A fit: the skeleton and its guessed pose, the cameras, and per view the clicked joints
+    (name -> pixel)."""
+
+    skeleton: Skeleton
+    bvh: BvhFile
+    guess: BodyPose
+    cameras: list[View]
+    clicks: list[dict[str, np.ndarray]]
+    mode: str
+
+
+def load_fit(path: str | Path) -> FitJob:
+    """Read and validate a fit file (a tracking job's ``skeleton``, ``initial``, ``views``
+    with cameras and no images needed, ``mode``, and ``clicks``: per view, joint -> [x, y])."""
+    path = Path(path)
+    d = _read_json(path, "fit file")
+    base, where = path.parent, path.name
+    sk, bvh, init_bvh, frame = _body(d, base, where)
+    views = _field(d, "views", where, list)
+    if not views:
+        raise JobError(f"{where}.views: expected at least one view")
+    cameras = [parse_camera(_field(v, "camera", f"{where}.views[{i}]"),
+                            f"{where}.views[{i}].camera") for i, v in enumerate(views)]
+    clicks_in = _field(d, "clicks", where, list)
+    if len(clicks_in) != len(views):
+        raise JobError(f"{where}.clicks: expected one object per view ({len(views)}), got "
+                       f"{len(clicks_in)}")
+    clicks = []
+    for i, c in enumerate(clicks_in):
+        w = f"{where}.clicks[{i}]"
+        if not isinstance(c, dict):
+            raise JobError(f"{w}: expected an object of joint name -> [x, y]")
+        for name in c:
+            if name not in sk.names:
+                raise JobError(f"{w}.{name}: no such joint in the BVH")
+        clicks.append({name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()})
+    return FitJob(sk, bvh, initial_pose(sk, init_bvh, frame, cameras), cameras, clicks,
+                  _mode(d, where))
 
 
 def world_root(mode: str, first_camera: View, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,150 @@
+"""The first frame's pose, and the body's proportions, from joints clicked in each view.
+
+Unknowns: the root's pose (one world pose when the cameras are calibrated; otherwise each view's
+scale, rotation and image translation, paper section 2.6), every tracked joint's rotation
+(balls as rotation vectors, hinges as angles) and one length factor per bone, shared by the
+left and right bones of a pair. Residuals: each clicked joint's projection minus its click,
+in pixels, with a robust (soft-L1) loss, plus weak priors that keep unconstrained unknowns at
+the guess. Solved by ``scipy.optimize.least_squares`` with length factors bounded to [0.5, 2].
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from . import se3
+from .camera import View
+from .pose import CALIBRATED, BodyPose
+from .skeleton import BALL, HINGE, Skeleton
+
+PRIOR_ANGLE = 0.02  # weight (pixels per radian) holding unconstrained rotations at the guess
+PRIOR_LENGTH = 0.5  # weight (pixels per unit of log length) holding lengths at the guess
+
+
+class FitError(ValueError):
+    """Clicks that cannot determine a pose; the message says what to add."""
+
+
+@dataclass
+class FitResult:
+    skeleton: Skeleton  # with the fitted offsets
+    pose: BodyPose
+    residual_px: float  # RMS distance of the clicked joints from their clicks
+    lengths: dict[str, float]  # fitted length factor of each bone (1: as guessed)
+
+
+def symmetry_key(name: str) -> str:
+    """Left and right bones share a key: LeftKnee, RightKnee -> *Knee; LHipJoint -> *HipJoint."""
+    key = re.sub(r"(Left|Right|left|right)", "*", name)
+    return re.sub(r"^[LR](?=[A-Z])", "*", key)
+
+
+def _check(sk: Skeleton, clicks: list[dict], n_unknowns: int) -> None:
+    """Refuse clicks that cannot determine the fit, saying what to add."""
+    for c, view_clicks in enumerate(clicks):
+        pts = np.array(list(view_clicks.values()), dtype=float).reshape(-1, 2)
+        if len(pts) >= 2 and np.linalg.matrix_rank(pts - pts.mean(0), tol=1.0) < 2:
+            raise FitError(f"view {c + 1}: the {len(pts)} clicks lie on one line; click joints "
+                           "off that line (a hand, a foot, the head)")
+    n = 2 * sum(len(v) for v in clicks)
+    if n < n_unknowns:
+        raise FitError(f"{n // 2} clicks give {n} numbers but the fit has {n_unknowns} "
+                       f"unknowns: click at least {(n_unknowns - n + 1) // 2} more joints")
+
+
+def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
+             fit_lengths: bool = True) -> FitResult:
+    """Fit pose (and lengths) to ``clicks`` (per view: joint name -> (x, y) pixels)."""
+    if len(clicks) != len(guess.views):
+        raise FitError(f"clicks for {len(clicks)} views, but {len(guess.views)} views")
+    for c, view_clicks in enumerate(clicks):
+        for name in view_clicks:
+            if name not in sk.names:
+                raise FitError(f"view {c + 1}: no joint named '{name}'")
+    dof_joint, dof_axis = sk.dof_joints_and_axes()
+    joints = sorted(set(dof_joint.tolist()))
+    # a bone whose two ends are both clicked gets its own length (shared with its mirror
+    # twin); every other bone scales with one common factor, so that unseen bones do not
+    # soak up the clicks' noise
+    clicked = {sk.index(n) for v in clicks for n in v}
+
+    def group_key(j: int) -> str:
+        both = j in clicked and sk.parents[j] in clicked
+        return symmetry_key(sk.names[j]) if both else "*body"
+
+    bones = [j for j in range(1, sk.n_joints) if np.linalg.norm(sk.offsets[j]) > 1e-9]
+    groups = sorted({group_key(j) for j in bones})
+    group_of = [groups.index(group_key(j)) if j in bones else -1 for j in range(sk.n_joints)]
+    n_root = 6 if mode == CALIBRATED else 6 * len(guess.views)
+    n_dof = len(dof_joint)
+    n_len = len(groups) if fit_lengths else 0
+    # what clicked joint positions can pin down: the root, and per joint with a clicked joint
+    # below it its swing (a ball's twist about its bone moves no joint on the bone); lengths
+    # lean on their prior and bounds
+    below = {a for n in (name for v in clicks for name in v)
+             for a in sk.ancestors(sk.index(n))[1:]}
+    swings = sum(2 if sk.kinds[j] == BALL else 1 for j in joints if j in below)
+    _check(sk, clicks, n_root + swings)
+
+    def unpack(x):
+        R = guess.rotations.copy()
+        k = n_root
+        for j in joints:
+            if sk.kinds[j] == BALL:
+                R[j] = guess.rotations[j] @ se3.exp_so3(x[k:k + 3])
+                k += 3
+            elif sk.kinds[j] == HINGE:
+                R[j] = guess.rotations[j] @ se3.exp_so3(sk.axes[j] * x[k])
+                k += 1
+        factors = np.exp(x[n_root + n_dof:]) if fit_lengths else np.ones(0)
+        scale = np.array([factors[g] if g >= 0 and fit_lengths else 1.0 for g in group_of])
+        offsets = sk.offsets * scale[:, None]
+        views = []
+        if mode == CALIBRATED:
+            R[0] = se3.exp_so3(x[3:6]) @ guess.rotations[0]
+            root = guess.root_position + x[:3]
+            views = guess.views
+        else:
+            root = guess.root_position
+            for c, v in enumerate(guess.views):
+                ds, t1, t2, w = x[6 * c], x[6 * c + 1], x[6 * c + 2], x[6 * c + 3:6 * c + 6]
+                E = se3.exp_so3(w)
+                P = v.pose
+                s = P.s * np.exp(ds)
+                views.append(View(se3.Similarity(s, E @ P.R, E @ P.t + np.array(
+                    [t1, t2, 0.0]) / s), v.center))
+        return R, root, offsets, views, factors
+
+    def positions(R, root, offsets):
+        fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites)
+        return fitted, fitted.world_positions(R, root)
+
+    def residuals(x):
+        R, root, offsets, views, factors = unpack(x)
+        _, X = positions(R, root, offsets)
+        res = []
+        for v, view_clicks in zip(views, clicks):
+            for name, p in view_clicks.items():
+                res.extend(v.project(X[sk.index(name)]) - np.asarray(p, float))
+        res.extend(PRIOR_ANGLE * x[n_root:n_root + n_dof])
+        res.extend(PRIOR_LENGTH * x[n_root + n_dof:])
+        return np.array(res)
+
+    x0 = np.zeros(n_root + n_dof + n_len)
+    lo = np.full_like(x0, -np.inf)
+    hi = np.full_like(x0, np.inf)
+    lo[n_root + n_dof:], hi[n_root + n_dof:] = np.log(0.5), np.log(2.0)
+    sol = least_squares(residuals, x0, bounds=(lo, hi), loss="soft_l1", f_scale=3.0,
+                        x_scale="jac")
+    R, root, offsets, views, factors = unpack(sol.x)
+    fitted, X = positions(R, root, offsets)
+    fitted.blobs = fitted.default_blobs()
+    n_clicks = sum(len(v) for v in clicks)
+    rms = float(np.sqrt(np.sum(sol.fun[:2 * n_clicks] ** 2) / max(n_clicks, 1)))
+    return FitResult(fitted, BodyPose(R, root, [v.copy() for v in views]), rms,
+                     {sk.names[j]: float(factors[group_of[j]]) for j in range(sk.n_joints)
+                      if group_of[j] >= 0 and fit_lengths})
