@@ -244,6 +244,16 @@ def _body(d: dict, base: Path, where: str) -> tuple[Skeleton, BvhFile, BvhFile, 
     return sk, bvh, init_bvh, frame
 
 
+def _views(d: dict, where: str) -> tuple[list[dict], list[View]]:
+    """The ``views`` field (at least one) and each view's camera."""
+    views = _field(d, "views", where, list)
+    if not views:
+        raise JobError(f"{where}.views: expected at least one view")
+    cameras = [parse_camera(_field(v, "camera", f"{where}.views[{i}]"),
+                            f"{where}.views[{i}].camera") for i, v in enumerate(views)]
+    return views, cameras
+
+
 def _mode(d: dict, where: str) -> str:
     mode = d.get("mode", INDEPENDENT)
     if mode not in (CALIBRATED, INDEPENDENT):
@@ -257,14 +267,9 @@ def load_job(path: str | Path) -> Job:
     d = _read_json(path, "job file")
     base, where = path.parent, path.name
     sk, bvh, init_bvh, frame = _body(d, base, where)
-    views = _field(d, "views", where, list)
-    if not views:
-        raise JobError(f"{where}.views: expected at least one view")
-    images, cameras = [], []
-    for i, v in enumerate(views):
-        w = f"{where}.views[{i}]"
-        images.append(_images(_field(v, "images", w), base, f"{w}.images"))
-        cameras.append(parse_camera(_field(v, "camera", w), f"{w}.camera"))
+    views, cameras = _views(d, where)
+    images = [_images(_field(v, "images", f"{where}.views[{i}]"), base,
+                      f"{where}.views[{i}].images") for i, v in enumerate(views)]
     counts = {len(x) for x in images}
     if len(counts) > 1:
         raise JobError(f"{where}.views: every view needs the same number of frames, got "
@@ -300,11 +305,7 @@ def load_fit(path: str | Path) -> FitJob:
     d = _read_json(path, "fit file")
     base, where = path.parent, path.name
     sk, bvh, init_bvh, frame = _body(d, base, where)
-    views = _field(d, "views", where, list)
-    if not views:
-        raise JobError(f"{where}.views: expected at least one view")
-    cameras = [parse_camera(_field(v, "camera", f"{where}.views[{i}]"),
-                            f"{where}.views[{i}].camera") for i, v in enumerate(views)]
+    views, cameras = _views(d, where)
     clicks_in = _field(d, "clicks", where, list)
     if len(clicks_in) != len(views):
         raise JobError(f"{where}.clicks: expected one object per view ({len(views)}), got "

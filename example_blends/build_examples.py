@@ -9,7 +9,6 @@ folder can move. The capture's frames that were rendered are kept as walk_3view/
 
 from __future__ import annotations
 
-import importlib.util
 import shutil
 import sys
 import tempfile
@@ -21,22 +20,13 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
+sys.path.insert(0, str(ROOT / "scripts"))
 
+from addon_dev import load_addon  # noqa: E402
 from walk_footage import render, tracking_scene  # noqa: E402
 
 WALK = dict(first=540, last=660, step=8)  # capture frames: one second at 15 fps
 VIEWS = ["lateral", "endon", "oblique60"]
-
-
-def load_addon():
-    """Register the add-on from this repository, imported as Blender imports the extension."""
-    if "twist_mocap" not in sys.modules:
-        spec = importlib.util.spec_from_file_location(
-            "twist_mocap", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)])
-        module = importlib.util.module_from_spec(spec)
-        sys.modules["twist_mocap"] = module
-        spec.loader.exec_module(module)
-    return sys.modules["twist_mocap"]
 
 
 def build_walk(bpy) -> Path:

@@ -18,10 +18,10 @@ import cv2
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "bench"), str(ROOT / "example_blends")]
+sys.path[:0] = [str(ROOT), str(ROOT / "bench"), str(ROOT / "scripts")]
 
 import evaluate  # noqa: E402
-from build_examples import load_addon  # noqa: E402
+from addon_dev import load_addon  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402

@@ -17,6 +17,7 @@ from ..core.job import JobError
 from ..core.video import is_video
 from .bridge import BridgeError, armature_from_skeleton, skeleton_from_armature
 from .keyframes import clear
+from .properties import first_frame_property
 from .track import TrackSession
 
 _EXPECTED = (BridgeError, ImageError, JobError, ValueError)
@@ -183,9 +184,7 @@ class TWIST_OT_add_view(bpy.types.Operator):
         name="Footage", subtype="FILE_PATH",
         description="A movie, or any image of the footage: its folder's images of the same "
                     "kind are read in name order")
-    first_frame: bpy.props.IntProperty(
-        name="First Frame", default=1,
-        description="The scene frame that shows the footage's first image")
+    first_frame: first_frame_property()
 
     def invoke(self, context, event):
         context.window_manager.fileselect_add(self)

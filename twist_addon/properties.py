@@ -51,6 +51,12 @@ def _is_camera(_self, obj) -> bool:
     return obj.type == "CAMERA"
 
 
+def first_frame_property():
+    return bpy.props.IntProperty(
+        name="First Frame", default=1,
+        description="The scene frame that shows the footage's first image")
+
+
 class TWIST_PG_view(bpy.types.PropertyGroup):
     """One view: a camera and the footage it sees, one image per scene frame."""
 
@@ -61,9 +67,7 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
         name="Footage", subtype="FILE_PATH",
         description="The footage's frames: a glob such as //walk/side_*.png (// is the .blend's "
                     "folder), read in name order")
-    first_frame: bpy.props.IntProperty(
-        name="First Frame", default=1,
-        description="The scene frame that shows the footage's first image")
+    first_frame: first_frame_property()
 
 
 class TWIST_PG_result(bpy.types.PropertyGroup):

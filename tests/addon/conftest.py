@@ -18,19 +18,15 @@ def bpy_module():
 
 @pytest.fixture(scope="session")
 def addon():
-    """The extension's package, imported as Blender imports it: the repository root is the
-    package (named ``twist_mocap`` here, whatever the clone's folder is called)."""
+    """The extension's package, imported as Blender imports it (scripts/addon_dev.py)."""
     import importlib
-    import importlib.util
 
-    if "twist_mocap" not in sys.modules:
-        spec = importlib.util.spec_from_file_location(
-            "twist_mocap", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)])
-        module = importlib.util.module_from_spec(spec)
-        sys.modules["twist_mocap"] = module
-        spec.loader.exec_module(module)
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from addon_dev import load_addon
+
+    module = load_addon()
     importlib.import_module("twist_mocap.twist_addon.bridge")
-    return sys.modules["twist_mocap"]
+    return module
 
 
 @pytest.fixture(scope="session")
