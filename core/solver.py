@@ -30,12 +30,10 @@ class DegenerateSystem(RuntimeError):
 
 @dataclass
 class NormalEquations:
-    """Accumulates A^T W A, A^T W r and the robust cost over blocks of rows."""
+    """Accumulates A^T W A and A^T W r over blocks of rows."""
 
     H: np.ndarray
     b: np.ndarray
-    cost: float = 0.0
-    weight: float = 0.0
     rows: int = 0
 
     @classmethod
@@ -47,7 +45,6 @@ class NormalEquations:
         Aw = A * w[:, None]
         self.H += Aw.T @ A
         self.b += Aw.T @ r
-        self.weight += float(np.sum(w))
         self.rows += len(r)
 
 
@@ -88,7 +85,7 @@ def solve(
     """
     if active is not None and not np.all(active):
         idx = np.flatnonzero(active)
-        sub = NormalEquations(ne.H[np.ix_(idx, idx)], ne.b[idx], ne.cost, ne.weight, ne.rows)
+        sub = NormalEquations(ne.H[np.ix_(idx, idx)], ne.b[idx], ne.rows)
         step = np.zeros(len(ne.b))
         step[idx] = solve(sub, damping, None if prior is None else prior[idx],
                           None if offset is None else offset[idx])

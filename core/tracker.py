@@ -3,12 +3,15 @@
 For each new frame the pose is predicted from the last two (constant velocity), then refined
 on an image pyramid from the coarsest level to the finest. Each iteration maps the body's
 pixels of two earlier frames -- the previous frame and the key frame (the first, user-posed
-one; it holds the track against drift) -- to the new frame under the current estimate,
-samples the new image there, and solves one linear system for all views (paper section 2.5).
-Pixels whose front-most blob in the new frame is not the blob they came from are left out
-(a leg passing behind the other); pixel weights are the blob's rim weight times the EM support
-posterior. A frame whose residual jumps, whose body leaves the images or whose system is
-degenerate is reported as diverged instead of being accepted.
+one, or the last the user corrected; it holds the track against drift) -- to the new frame
+under the current estimate, samples the new image there, and solves one linear system for all
+views (paper section 2.5), as a Levenberg-Marquardt step that is kept only if it lowers the
+robust cost on the pixels visible before and after it, and shortened so that no joint turns
+more than a few degrees at once. A joint is solved only on levels where its blob is thick
+enough to see. Pixels whose front-most blob in the new frame is not the blob they came from
+are left out (a leg passing behind the other); pixel weights are the blob's rim weight times
+the EM support posterior. A frame whose residual jumps, whose body leaves the images or whose
+system is degenerate is reported as diverged instead of being accepted.
 """
 
 from __future__ import annotations
@@ -255,7 +258,6 @@ class Tracker:
             if len(ok):
                 w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
                 ne.add(rows(kin, ps.view, self.mode, ps.seg_joint[ok], q, grad), r, w)
-        ne.cost = float(np.nansum(smp.costs))
         return ne
 
     def _sigmas(self, est: BodyPose, kin: Kinematics, sets, levels) -> list[float]:
