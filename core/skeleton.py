@@ -296,23 +296,24 @@ def planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1)) -> Skeleton:
 
 def planar_quadruped_template() -> Skeleton:
     """A horse-like body seen from its side (+x forward, y up, z toward the camera): a rigid
-    trunk carrying neck and head and four two-segment legs, every joint a hinge about z."""
+    trunk from rump to chest (its joint at the rump) carrying neck and head and four
+    two-segment legs, every joint a hinge about z."""
     z = (0, 0, 1)
     spec = [
-        ("Trunk", None, (0, 1.3, 0), FIXED),
-        ("Neck", "Trunk", (0.8, 0.1, 0), HINGE, z),
+        ("Trunk", None, (-0.8, 1.3, 0), FIXED),
+        ("Neck", "Trunk", (1.6, 0.1, 0), HINGE, z),
         ("Head", "Neck", (0.45, 0.45, 0), HINGE, z),
     ]
-    ends = [(0.8, 0, 0), None, (0.35, -0.35, 0)]
+    ends = [None, None, (0.35, -0.35, 0)]
     for side, dz in (("Left", 0.15), ("Right", -0.15)):
-        for end, x in (("Fore", 0.7), ("Hind", -0.7)):
+        for end, x in (("Fore", 1.5), ("Hind", 0.1)):
             top, low = f"{side}{end}Upper", f"{side}{end}Lower"
             spec += [(top, "Trunk", (x, -0.15, dz), HINGE, z),
                      (low, top, (0, -0.55, 0), HINGE, z)]
             ends += [None, (0, -0.55, 0)]
     sk = _build(spec, ends)
-    trunk = sk.rest_positions[0]
-    sk.blobs = [bone_blob(0, "Trunk", trunk - (0.85, 0, 0), np.array([1.7, 0, 0]), (0.33, 0.25))]
+    sk.blobs = [bone_blob(0, "Trunk", sk.rest_positions[0] - (0.05, 0, 0),
+                          sk.offsets[1] + (0.1, 0, 0), (0.33, 0.25))]
     sk.blobs += [b for b in sk.default_blobs() if b.joint != 0]
     return sk
 

@@ -3,8 +3,14 @@ environment): ``python example_blends/build_examples.py``.
 
 walk_3view.blend: three orthographic views of the CMU walk, rendered by bench/walk_footage.py
 (one second of steady walking at 15 frames per second, JPEG frames in walk_3view/), the
-capture's armature posed on frame 1, ready for Track. Paths are relative to the .blend, so the
-folder can move. The capture's frames that were rendered are kept as walk_3view/truth.bvh.
+capture's armature posed on frame 1, ready for Track. The capture's frames that were rendered
+are kept as walk_3view/truth.bvh.
+
+muybridge_horse.blend: Muybridge's "Sallie Gardner at a Gallop" plates behind one orthographic
+camera, and the planar quadruped template placed and scaled over the horse on plate 1 (its
+legs still to be posed over the plate by the user).
+
+Paths are relative to each .blend, so the folder can move.
 """
 
 from __future__ import annotations
@@ -43,8 +49,6 @@ def build_walk(bpy) -> Path:
                             [cv2.IMWRITE_JPEG_QUALITY, 92])
         shutil.copy(Path(tmp) / "truth.bvh", out / "truth.bvh")
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    addon = load_addon()
-    addon.register()
     path = HERE / "walk_3view.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))  # so that // paths mean this folder
     scene, arm = tracking_scene(bpy, out, VIEWS, len(info["frames"]), "*.jpg")
@@ -56,10 +60,43 @@ def build_walk(bpy) -> Path:
     return path
 
 
+HORSE_PLATES = ROOT.parent / "shared" / "data" / "muybridge" / "horse_gallop"
+
+
+def build_horse(bpy) -> Path:
+    out = HERE / "muybridge_horse"
+    if out.exists():
+        shutil.rmtree(out)
+    out.mkdir()
+    plates = sorted(HORSE_PLATES.glob("*.png"))
+    for p in plates:
+        shutil.copy(p, out / p.name)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    path = HERE / "muybridge_horse.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.twist.add_view(filepath=str(out / plates[0].name), first_frame=1)
+    scene = bpy.context.scene
+    cam = scene.twist.views[0].camera
+    # the template's trunk along the horse's barrel (rump at (88, 92)), its poll near the
+    # ears: 70 px per metre across the 300 x 200 plate
+    cam.data.ortho_scale = 300 / 70.2
+    cam.location = (0.076, -10.0, 1.193)
+    bpy.ops.twist.add_template_armature(template="QUADRUPED")
+    scene.twist.mode = "INDEPENDENT"
+    scene.frame_start, scene.frame_end = 1, len(plates)
+    scene.render.fps = 15
+    scene.camera = cam
+    scene.frame_set(1)
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), relative_remap=True)
+    return path
+
+
 def main() -> int:
     import bpy
 
+    load_addon().register()  # its classes outlive the factory resets below
     print(build_walk(bpy))
+    print(build_horse(bpy))
     return 0
 
 

@@ -216,11 +216,11 @@ class TWIST_OT_add_view(bpy.types.Operator):
         else:
             count = len(glob.glob(pattern))
             image = bpy.data.images.load(str(path), check_existing=True)
+            img_w, img_h = image.size  # a sequence reports no size until it is shown
             image.source = "SEQUENCE" if count > 1 else "FILE"
             bg.image = image
             bg.image_user.frame_start = self.first_frame
             bg.image_user.frame_duration = count
-            img_w, img_h = image.size
         if img_w and img_h and n == 1:
             scene.render.resolution_x, scene.render.resolution_y = img_w, img_h
         view = scene.twist.views.add()

@@ -1,0 +1,30 @@
+"""The example scenes open ready to track: footage found for every frame of every view,
+orthographic cameras, an armature the bridge accepts, paths relative to the .blend."""
+
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "example_blends"
+
+
+@pytest.mark.parametrize("name, views, frames, mode", [
+    ("walk_3view.blend", 3, 16, "CALIBRATED"),
+    ("muybridge_horse.blend", 1, 15, "INDEPENDENT"),
+])
+def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, frames, mode):
+    bpy = bpy_module
+    bpy.ops.wm.open_mainfile(filepath=str(EXAMPLES / name))
+    scene = bpy.context.scene
+    tw = scene.twist
+    twist_addon = registered.twist_addon
+    assert len(tw.views) == views and tw.mode == mode
+    assert scene.frame_end - scene.frame_start + 1 == frames
+    for v in tw.views:
+        assert v.images.startswith("//")  # relative: the folder can move
+        paths = twist_addon.track.footage_frames(v, list(range(scene.frame_start,
+                                                              scene.frame_end + 1)))
+        assert len(paths) == frames and all(Path(p).is_file() for p in paths)
+        twist_addon.bridge.view_from_camera(v.camera, scene)  # orthographic, square pixels
+    sk = twist_addon.bridge.skeleton_from_armature(tw.armature)
+    assert len(sk.dof_names()) >= 10 and sk.blobs
