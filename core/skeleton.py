@@ -261,7 +261,14 @@ def human_template() -> Skeleton:
     ]
     ends = [None, None, None, (0, 0.25, 0), None, (0, -0.27, 0), None, (0, -0.27, 0), None,
             (0, -0.43, 0), None, (0, -0.43, 0)]
-    return _build(spec, ends)
+    sk = _build(spec, ends)
+    # an adult's widths (metres), in place of the length-based defaults
+    radius = {"Hips": 0.13, "Spine": 0.13, "Chest": 0.11, "Neck": 0.09, "LeftShoulder": 0.045,
+              "RightShoulder": 0.045, "LeftElbow": 0.04, "RightElbow": 0.04, "LeftHip": 0.08,
+              "RightHip": 0.08, "LeftKnee": 0.055, "RightKnee": 0.055}
+    for b in sk.blobs:
+        b.radii[1:] = radius[sk.names[b.joint]]
+    return sk
 
 
 def walker_template() -> Skeleton:

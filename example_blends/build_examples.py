@@ -7,8 +7,9 @@ capture's armature posed on frame 1, ready for Track. The capture's frames that 
 are kept as walk_3view/truth.bvh.
 
 muybridge_horse.blend: Muybridge's "Sallie Gardner at a Gallop" plates behind one orthographic
-camera, and the planar quadruped template placed and scaled over the horse on plate 1 (its
-legs still to be posed over the plate by the user).
+camera, and the planar quadruped template placed and scaled over the horse on plate 1;
+muybridge_woman.blend: a woman jumping, with the 19-degree-of-freedom human placed over her.
+Their limbs are left for the user to pose over the first plate.
 
 Paths are relative to each .blend, so the folder can move.
 """
@@ -21,6 +22,7 @@ import tempfile
 from pathlib import Path
 
 import cv2
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -60,30 +62,31 @@ def build_walk(bpy) -> Path:
     return path
 
 
-HORSE_PLATES = ROOT.parent / "shared" / "data" / "muybridge" / "horse_gallop"
+MUYBRIDGE = ROOT.parent / "shared" / "data" / "muybridge"
 
 
-def build_horse(bpy) -> Path:
-    out = HERE / "muybridge_horse"
+def build_plates(bpy, name: str, plates: Path, template: str, ortho_scale: float,
+                 location: tuple, turn_deg: float = 0.0) -> Path:
+    """One view of Muybridge plates with a template armature placed over the subject."""
+    out = HERE / name
     if out.exists():
         shutil.rmtree(out)
     out.mkdir()
-    plates = sorted(HORSE_PLATES.glob("*.png"))
-    for p in plates:
+    files = sorted(plates.glob("*.png"))
+    for p in files:
         shutil.copy(p, out / p.name)
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    path = HERE / "muybridge_horse.blend"
+    path = HERE / f"{name}.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
-    bpy.ops.twist.add_view(filepath=str(out / plates[0].name), first_frame=1)
+    bpy.ops.twist.add_view(filepath=str(out / files[0].name), first_frame=1)
     scene = bpy.context.scene
     cam = scene.twist.views[0].camera
-    # the template's trunk along the horse's barrel (rump at (88, 92)), its poll near the
-    # ears: 70 px per metre across the 300 x 200 plate
-    cam.data.ortho_scale = 300 / 70.2
-    cam.location = (0.076, -10.0, 1.193)
-    bpy.ops.twist.add_template_armature(template="QUADRUPED")
+    cam.data.ortho_scale = ortho_scale
+    cam.location = location
+    bpy.ops.twist.add_template_armature(template=template)
+    scene.twist.armature.rotation_euler[2] = np.radians(turn_deg)
     scene.twist.mode = "INDEPENDENT"
-    scene.frame_start, scene.frame_end = 1, len(plates)
+    scene.frame_start, scene.frame_end = 1, len(files)
     scene.render.fps = 15
     scene.camera = cam
     scene.frame_set(1)
@@ -96,7 +99,14 @@ def main() -> int:
 
     load_addon().register()  # its classes outlive the factory resets below
     print(build_walk(bpy))
-    print(build_horse(bpy))
+    # the horse: the quadruped's trunk along the barrel (rump at (88, 92)), its poll near the
+    # ears, 70 px per metre across the 300 x 200 plates
+    print(build_plates(bpy, "muybridge_horse", MUYBRIDGE / "horse_gallop", "QUADRUPED",
+                       300 / 70.2, (0.076, -10.0, 1.193)))
+    # the woman (facing right): hips near (85, 193) and feet on the plate's bottom, 160 px per
+    # metre down the 185 x 375 plates; the human turned to face the image's right
+    print(build_plates(bpy, "muybridge_woman", MUYBRIDGE / "woman_jumping", "HUMAN",
+                       375 / 160, (0.044, -10.0, 0.9875), turn_deg=90))
     return 0
 
 

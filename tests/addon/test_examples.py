@@ -11,6 +11,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "example_blends"
 @pytest.mark.parametrize("name, views, frames, mode", [
     ("walk_3view.blend", 3, 16, "CALIBRATED"),
     ("muybridge_horse.blend", 1, 15, "INDEPENDENT"),
+    ("muybridge_woman.blend", 1, 10, "INDEPENDENT"),
 ])
 def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, frames, mode):
     bpy = bpy_module
