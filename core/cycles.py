@@ -1,0 +1,103 @@
+"""Walk cycles from tracked motion: the gait period, a half cycle completed by mirroring, a
+seamless loop, and zero-phase smoothing.
+
+Curves are arrays (frames, channels) sampled at a fixed rate; rotations are unit quaternions
+(frames, 4). Which channels are the left and which the right side is the caller's to say.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.signal import butter, filtfilt
+
+
+def gait_period(curves: np.ndarray, min_frames: int = 4) -> float:
+    """Period in frames (sub-frame) of the repetition in ``curves`` (F, C): the first peak of
+    the mean normalised autocorrelation past its first zero crossing that reaches 80 % of the
+    highest there (later peaks are multiples), refined by a parabola through its neighbours."""
+    x = np.asarray(curves, float).reshape(len(curves), -1)
+    x = (x - x.mean(0)) / np.maximum(x.std(0), 1e-12)
+    F = len(x)
+    ac = np.array([np.mean(x[: F - k] * x[k:]) for k in range(F // 2)])
+    below = np.flatnonzero(ac < 0)
+    if not len(below):
+        raise ValueError("the curves do not repeat within half their length")
+    start = max(int(below[0]), min_frames)
+    tail = ac[start:]
+    peaks = [i for i in range(1, len(tail) - 1)
+             if tail[i - 1] <= tail[i] >= tail[i + 1] and tail[i] >= 0.8 * tail.max()]
+    k = start + (peaks[0] if peaks else int(np.argmax(tail)))
+    if k + 1 < len(ac):
+        a, b, c = ac[k - 1], ac[k], ac[k + 1]
+        if a - 2 * b + c < 0:
+            return float(k + 0.5 * (a - c) / (a - 2 * b + c))
+    return float(k)
+
+
+def _sample(curve: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Linear interpolation of a curve (F, C) at fractional frames t (clamped)."""
+    F = len(curve)
+    t = np.clip(t, 0, F - 1)
+    i = np.minimum(np.floor(t).astype(int), F - 2)
+    f = (t - i)[:, None]
+    return curve[i] * (1 - f) + curve[i + 1] * f
+
+
+def mirror_half_cycle(left: np.ndarray, right: np.ndarray, period: float,
+                      mirror: Callable[[np.ndarray], np.ndarray] = lambda c: c
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Complete a gait recorded over less than a cycle (the paper completed a 60 % walk this
+    way): each side at frame t moves as the other side did at t - period / 2, passed through
+    ``mirror`` (which maps one side's channels onto the other's, e.g. flipping the sign of
+    sideways angles). left, right: (F, C) with F >= period / 2. Returns both sides over one
+    period (round(period) frames): recorded frames as they were, the rest filled in."""
+    half = period / 2
+    F = len(left)
+    if F < half:
+        raise ValueError(f"{F} frames are less than half a period ({half:.1f} frames)")
+    n = int(round(period))
+    t = np.arange(n, dtype=float)
+    have = t < F
+    out_l = np.concatenate([left[: have.sum()], mirror(_sample(right, t[~have] - half))])
+    out_r = np.concatenate([right[: have.sum()], mirror(_sample(left, t[~have] - half))])
+    return out_l, out_r
+
+
+def make_loop(cycle: np.ndarray, blend: int) -> np.ndarray:
+    """The cycle (F, C) with its last ``blend`` frames replaced by a cubic Hermite bridge from
+    frame F - blend - 1 (its value and slope) to the cycle's start seen as frame F (value and
+    slope of frames 0 and 1), so that repeating it is continuous in value and slope."""
+    x = np.asarray(cycle, float).copy()
+    F = len(x)
+    if not 1 <= blend < F - 2:
+        raise ValueError(f"blend must be between 1 and {F - 3} frames")
+    a = F - blend - 1
+    p0, m0 = x[a], x[a] - x[a - 1]
+    p1, m1 = x[0], x[1] - x[0]
+    L = F - a  # frames from the bridge's start to the next cycle's first frame
+    u = (np.arange(1, blend + 1) / L)[:, None]
+    x[a + 1:] = ((2 * u**3 - 3 * u**2 + 1) * p0 + (u**3 - 2 * u**2 + u) * L * m0
+                 + (-2 * u**3 + 3 * u**2) * p1 + (u**3 - u**2) * L * m1)
+    return x
+
+
+def lowpass(curves: np.ndarray, cutoff_hz: float, fps: float) -> np.ndarray:
+    """Zero-phase Butterworth low-pass (second order, run forward and back) of curves (F, C)."""
+    if not 0 < cutoff_hz < fps / 2:
+        raise ValueError(f"the cutoff must be between 0 and {fps / 2} Hz (half the frame rate)")
+    b, a = butter(2, cutoff_hz / (fps / 2))
+    return filtfilt(b, a, np.asarray(curves, float), axis=0,
+                    padlen=min(len(curves) - 1, 3 * max(len(a), len(b))))
+
+
+def lowpass_quaternions(q: np.ndarray, cutoff_hz: float, fps: float) -> np.ndarray:
+    """Low-pass a rotation track (F, 4): each quaternion first put on the side of its
+    predecessor (q and -q are one rotation), then filtered and normalised."""
+    q = np.asarray(q, float).copy()
+    for i in range(1, len(q)):
+        if q[i] @ q[i - 1] < 0:
+            q[i] = -q[i]
+    f = lowpass(q, cutoff_hz, fps)
+    return f / np.linalg.norm(f, axis=1, keepdims=True)
