@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import operators, overlay, panels, properties
+from . import export, operators, overlay, panels, properties
 
-MODULES = (properties, operators, panels, overlay)
+MODULES = (properties, operators, export, panels, overlay)
 
 
 def register():
