@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import export, operators, overlay, panels, properties
+from . import cycle, export, operators, overlay, panels, properties
 
-MODULES = (properties, operators, export, panels, overlay)
+MODULES = (properties, operators, cycle, export, panels, overlay)
 
 
 def register():

@@ -66,6 +66,7 @@ class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
         row.scale_y = 1.4
         row.operator("twist.track", icon="TRACKING")
         layout.operator("twist.clear_track", icon="X")
+        layout.operator("twist.make_cycle", icon="FILE_REFRESH")
         row = layout.row(align=True)
         row.operator("twist.export_bvh", text="BVH", icon="EXPORT")
         row.operator("twist.export_fbx", text="FBX", icon="EXPORT")
