@@ -13,7 +13,8 @@ FRAMES = 8
 
 @pytest.fixture
 def animated(bpy_module, registered, cmu_walk, tmp_path):
-    """The CMU walk imported as an animated armature (frames 1..FRAMES), set to export."""
+    """The CMU walk imported as an animated armature (frames 1..FRAMES), set to export; with
+    its bones' parents and, per frame, the world direction of every bone."""
     bpy = bpy_module
     b = read_bvh(cmu_walk)
     b.motion = b.motion[600:600 + FRAMES]
@@ -24,7 +25,10 @@ def animated(bpy_module, registered, cmu_walk, tmp_path):
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, FRAMES
     scene.twist.armature = arm
-    return bpy, scene, arm
+    parents = {b.name: b.parent.name if b.parent else None for b in arm.data.bones}
+    source = [_bone_directions(_blender_heads(bpy, scene, arm, f), parents)
+              for f in range(1, FRAMES + 1)]
+    return bpy, scene, arm, parents, source
 
 
 def _bone_directions(heads: dict, parents: dict) -> dict:
@@ -45,10 +49,7 @@ def _max_angle(a: dict, b: dict) -> float:
 
 
 def test_bvh_round_trip_through_blender_and_an_independent_reader(animated, tmp_path):
-    bpy, scene, arm = animated
-    parents = {b.name: b.parent.name if b.parent else None for b in arm.data.bones}
-    source = [_bone_directions(_blender_heads(bpy, scene, arm, f), parents)
-              for f in range(1, FRAMES + 1)]
+    bpy, scene, arm, parents, source = animated
     out = tmp_path / "out.bvh"
     assert bpy.ops.twist.export_bvh(filepath=str(out)) == {"FINISHED"}
     # the project's own reader (no code shared with Blender's exporter)
@@ -107,10 +108,7 @@ def test_fbx_round_trip_through_blender_and_ufbx(animated, tmp_path):
     import subprocess
     import sys
 
-    bpy, scene, arm = animated
-    parents = {b.name: b.parent.name if b.parent else None for b in arm.data.bones}
-    source = [_bone_directions(_blender_heads(bpy, scene, arm, f), parents)
-              for f in range(1, FRAMES + 1)]
+    bpy, scene, arm, parents, source = animated
     out = tmp_path / "out.fbx"
     assert bpy.ops.twist.export_fbx(filepath=str(out)) == {"FINISHED"}
     # an independent reader, in its own process (it can crash its interpreter)
