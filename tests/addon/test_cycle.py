@@ -3,35 +3,12 @@
 import numpy as np
 import pytest
 
-PERIOD = 24.5
-
-
-def _walking_template(bpy, registered, frames=70):
-    from core import se3
-
-    bpy.ops.twist.add_template_armature(template="HUMAN")
-    scene = bpy.context.scene
-    arm = scene.twist.armature
-    tw = registered.twist_addon
-    sk = tw.bridge.skeleton_from_armature(arm)
-    R0, root0 = tw.bridge.pose_from_armature(arm, sk)
-    for f in range(1, frames + 1):
-        phase = 2 * np.pi * f / PERIOD
-        R = R0.copy()
-        for name, sign in (("LeftHip", 1), ("RightHip", -1)):
-            R[sk.index(name)] = se3.exp_so3(np.array([0.5 * sign * np.sin(phase), 0, 0]))
-        for name, shift in (("LeftKnee", 0.0), ("RightKnee", np.pi)):
-            j = sk.index(name)
-            R[j] = se3.exp_so3(sk.axes[j] * (0.6 + 0.5 * np.sin(phase + shift)))
-        root = root0 + np.array([0, -0.05 * f, 0.03 * np.sin(2 * phase)])  # walks toward -y
-        tw.keyframes.write_pose(arm, sk, f, R, root)
-    scene.frame_start, scene.frame_end = 1, frames
-    return scene, arm
+from support.walking import PERIOD, walking_template
 
 
 def test_make_cycle_finds_the_period_and_loops_seamlessly(bpy_module, registered):
     bpy = bpy_module
-    scene, arm = _walking_template(bpy, registered)
+    scene, arm = walking_template(bpy, registered)
     assert bpy.ops.twist.make_cycle() == {"FINISHED"}
     bag = registered.twist_addon.cycle._channelbag(arm)
     curves = [fc for fc in bag.fcurves]
@@ -51,7 +28,7 @@ def test_make_cycle_finds_the_period_and_loops_seamlessly(bpy_module, registered
 
 def test_make_cycle_can_keep_walking_forward(bpy_module, registered):
     bpy = bpy_module
-    scene, arm = _walking_template(bpy, registered)
+    scene, arm = walking_template(bpy, registered)
     bag = registered.twist_addon.cycle._channelbag(arm)
     root_y = max((fc for fc in bag.fcurves if fc.data_path.endswith("location")),
                  key=lambda fc: abs(fc.evaluate(70) - fc.evaluate(1)))  # the walking direction

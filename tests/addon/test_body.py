@@ -1,0 +1,41 @@
+"""The volumetric body rides on the armature: every ellipsoid stays its blob, frame by frame."""
+
+import numpy as np
+import pytest
+
+
+def test_volumetric_body_follows_the_tracked_armature(bpy_module, registered):
+    bpy = bpy_module
+    from support.walking import walking_template
+
+    scene, arm = walking_template(bpy, registered, frames=12)
+    scene.frame_set(1)
+    assert bpy.ops.twist.add_volumetric_body() == {"FINISHED"}
+    tw = registered.twist_addon
+    sk = tw.bridge.skeleton_from_armature(arm)
+    bodies = {o.name: o for o in bpy.data.collections["Twist body"].objects}
+    assert len(bodies) == len(sk.blobs)
+    left = bodies["body LeftKnee"].data.materials[0].diffuse_color[:]
+    right = bodies["body RightKnee"].data.materials[0].diffuse_color[:]
+    assert left != right  # a material per side
+    for f in (1, 5, 12):
+        scene.frame_set(f)
+        R, root = tw.bridge.pose_from_armature(arm, sk)
+        g = sk.segment_motions(sk.joint_frames(R, root))
+        for b in sk.blobs:
+            want = g[b.joint] @ tw.body.blob_matrix(b)
+            got = np.array(bodies[f"body {sk.names[b.joint]}"].matrix_world)
+            np.testing.assert_allclose(got, want, atol=1e-5)
+
+
+def test_no_blobs_no_body(bpy_module, registered):
+    bpy = bpy_module
+    bpy.ops.twist.add_template_armature(template="WALKER")
+    arm = bpy.context.scene.twist.armature
+    bpy.context.view_layer.objects.active = arm
+    bpy.ops.object.mode_set(mode="EDIT")
+    for eb in arm.data.edit_bones:
+        eb.head_radius = eb.tail_radius = 0.0
+    bpy.ops.object.mode_set(mode="OBJECT")
+    with pytest.raises(RuntimeError, match="no bone of 'Walker' has a blob"):
+        bpy.ops.twist.add_volumetric_body()
