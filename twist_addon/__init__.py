@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import body, cycle, export, operators, overlay, panels, properties
+from . import body, cycle, export, fit, operators, overlay, panels, properties
 
-MODULES = (properties, operators, body, cycle, export, panels, overlay)
+MODULES = (properties, operators, fit, body, cycle, export, panels, overlay)
 
 
 def register():

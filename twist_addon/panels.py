@@ -52,6 +52,9 @@ class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
         layout = self.layout
         layout.prop(tw, "armature")
         layout.prop(tw, "show_overlay")
+        row = layout.row(align=True)
+        row.operator("twist.import_markers", icon="IMPORT")
+        row.operator("twist.fit_pose", icon="CON_KINEMATIC")
         layout.operator_menu_enum("twist.add_template_armature", "template", icon="ARMATURE_DATA")
 
 

@@ -57,6 +57,14 @@ def first_frame_property():
         description="The scene frame that shows the footage's first image")
 
 
+class TWIST_PG_marker(bpy.types.PropertyGroup):
+    """A joint placed on a view's footage: the head of ``bone`` at pixel (x, y)."""
+
+    bone: bpy.props.StringProperty(name="Bone", description="The bone whose head this marks")
+    x: bpy.props.FloatProperty(name="X", description="Pixels from the left")
+    y: bpy.props.FloatProperty(name="Y", description="Pixels from the top")
+
+
 class TWIST_PG_view(bpy.types.PropertyGroup):
     """One view: a camera and the footage it sees, one image per scene frame."""
 
@@ -68,6 +76,7 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
         description="The footage's frames: a glob such as //walk/side_*.png (// is the .blend's "
                     "folder), read in name order")
     first_frame: first_frame_property()
+    markers: bpy.props.CollectionProperty(type=TWIST_PG_marker)
 
 
 class TWIST_PG_result(bpy.types.PropertyGroup):
@@ -113,7 +122,8 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
                ("BACKWARD", "Backward", "From the current frame back to the scene's start")])
 
 
-CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_view, TWIST_PG_result, TWIST_PG_scene)
+CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_marker, TWIST_PG_view, TWIST_PG_result,
+           TWIST_PG_scene)
 
 
 def register():

@@ -1,0 +1,139 @@
+"""Fit the armature's pose on the current frame to joint markers placed in each view: the
+paper's initialisation from clicked joints (section 2.6). Bone lengths stay as they are here
+(``python -m core fit`` fits them too).
+
+Markers are kept per view as (bone, x, y) in the view's image pixels (x right, y down, origin
+at the top-left pixel's centre); a bone's marker is the position of its head.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+from ..core.init_fit import FitError, fit_pose
+from ..core.job import world_root
+from ..core.pose import BodyPose
+from .bridge import (
+    BridgeError,
+    armature_rotations,
+    pose_from_armature,
+    skeleton_from_armature,
+    view_from_camera,
+)
+
+
+def read_markers_csv(path: Path, scene) -> int:
+    """Load markers from a CSV of ``view, bone, x, y`` rows (view: 1-based number or camera
+    name; a header row is skipped) into the scene's views; returns how many were read."""
+    tw = scene.twist
+    by_name = {v.camera.name: v for v in tw.views if v.camera}
+    count = 0
+    with open(path, newline="") as f:
+        for i, row in enumerate(csv.reader(f), 1):
+            if not row or row[0].strip().lower() == "view":
+                continue
+            if len(row) != 4:
+                raise BridgeError(f"{path.name}, row {i}: expected view, bone, x, y")
+            key, bone, x, y = (c.strip() for c in row)
+            view = by_name.get(key) or (tw.views[int(key) - 1] if key.isdigit()
+                                        and 0 < int(key) <= len(tw.views) else None)
+            if view is None:
+                raise BridgeError(f"{path.name}, row {i}: no view '{key}'")
+            try:
+                xy = float(x), float(y)
+            except ValueError:
+                raise BridgeError(f"{path.name}, row {i}: x and y must be numbers") from None
+            m = next((m for m in view.markers if m.bone == bone), None) or view.markers.add()
+            m.bone, m.x, m.y = bone, *xy
+            count += 1
+    return count
+
+
+def fit_armature(scene) -> float:
+    """Pose the scene's armature to its views' markers (its bone lengths kept); returns the
+    RMS pixel error."""
+    tw = scene.twist
+    arm = tw.armature
+    if arm is None:
+        raise BridgeError("no armature is set (Twist Mocap > Armature)")
+    sk = skeleton_from_armature(arm)
+    views = [view_from_camera(v.camera, scene) for v in tw.views if v.camera]
+    if not views:
+        raise BridgeError("there are no views with cameras to place markers in")
+    clicks = []
+    for v in tw.views:
+        for m in v.markers:
+            if m.bone not in sk.names:
+                raise BridgeError(f"a marker names bone '{m.bone}', which '{arm.name}' lacks")
+        clicks.append({m.bone: np.array([m.x, m.y]) for m in v.markers})
+    R, root = pose_from_armature(arm, sk)
+    mode = tw.mode.lower()
+    try:
+        res = fit_pose(sk, BodyPose(R, root, views), clicks, mode, fit_lengths=False)
+    except FitError as e:
+        raise BridgeError(str(e)) from None
+    R_fit = res.pose.rotations.copy()
+    R_fit[0], root_fit = world_root(mode, views[0], res.pose)
+    Q, loc = armature_rotations(arm, sk, R_fit, root_fit)
+    for j, name in enumerate(sk.names):
+        pb = arm.pose.bones[name]
+        if pb.rotation_mode == "QUATERNION":
+            pb.rotation_quaternion = Matrix(Q[j].tolist()).to_quaternion()
+        elif pb.rotation_mode != "AXIS_ANGLE":
+            pb.rotation_euler = Matrix(Q[j].tolist()).to_euler(pb.rotation_mode)
+    arm.pose.bones[sk.names[0]].location = loc
+    return res.residual_px
+
+
+class TWIST_OT_import_markers(bpy.types.Operator):
+    """Read joint markers from a CSV file of view, bone, x, y rows (pixels, y down)"""
+
+    bl_idname = "twist.import_markers"
+    bl_label = "Import Markers"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: bpy.props.StringProperty(name="CSV File", subtype="FILE_PATH",
+                                       description="The markers: view, bone, x, y per row")
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        try:
+            n = read_markers_csv(Path(bpy.path.abspath(self.filepath)), context.scene)
+        except (BridgeError, OSError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"read {n} markers")
+        return {"FINISHED"}
+
+
+class TWIST_OT_fit_pose(bpy.types.Operator):
+    """Pose the armature on the current frame so that its joints land on the markers"""
+
+    bl_idname = "twist.fit_pose"
+    bl_label = "Fit Pose to Markers"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene.twist.armature is not None
+
+    def execute(self, context):
+        try:
+            rms = fit_armature(context.scene)
+        except BridgeError as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        context.view_layer.update()
+        self.report({"INFO"}, f"fitted: joints {rms:.1f} px from their markers (RMS)")
+        return {"FINISHED"}
+
+
+CLASSES = (TWIST_OT_import_markers, TWIST_OT_fit_pose)
