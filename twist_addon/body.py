@@ -8,6 +8,7 @@ import numpy as np
 from mathutils import Matrix
 
 from .bridge import BridgeError, pose_from_armature, skeleton_from_armature
+from .reporting import ArmatureAction
 
 SIDE_COLOURS = {"Left": (0.75, 0.25, 0.2, 1.0), "Right": (0.2, 0.35, 0.75, 1.0),
                 None: (0.8, 0.75, 0.65, 1.0)}
@@ -66,26 +67,16 @@ def add_body(context, arm) -> list[bpy.types.Object]:
     return made
 
 
-class TWIST_OT_add_volumetric_body(bpy.types.Operator):
+class TWIST_OT_add_volumetric_body(ArmatureAction, bpy.types.Operator):
     """Add an ellipsoid for every blob of the armature, riding on its bone, coloured by side"""
 
     bl_idname = "twist.add_volumetric_body"
     bl_label = "Add Volumetric Body"
-    bl_options = {"REGISTER", "UNDO"}
 
-    @classmethod
-    def poll(cls, context):
-        return context.scene.twist.armature is not None
-
-    def execute(self, context):
+    def run(self, context) -> str:
         arm = context.scene.twist.armature
-        try:
-            made = add_body(context, arm)
-        except BridgeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"added {len(made)} ellipsoids riding on '{arm.name}'")
-        return {"FINISHED"}
+        made = add_body(context, arm)
+        return f"added {len(made)} ellipsoids riding on '{arm.name}'"
 
 
 CLASSES = (TWIST_OT_add_volumetric_body,)

@@ -10,6 +10,7 @@ from bpy_extras import anim_utils
 from ..core.cycles import gait_period, make_loop
 from .bridge import BridgeError, skeleton_from_armature
 from .keyframes import TRACKED, channels
+from .reporting import ArmatureAction
 
 
 def _channelbag(arm):
@@ -74,13 +75,12 @@ def make_cycle(arm, first: int, last: int, period: float | None = None,
     return start, n
 
 
-class TWIST_OT_make_cycle(bpy.types.Operator):
+class TWIST_OT_make_cycle(ArmatureAction, bpy.types.Operator):
     """Make the tracked motion one seamless, repeating walk cycle (its gait period found from
     the legs), in place or travelling forward"""
 
     bl_idname = "twist.make_cycle"
     bl_label = "Make Walk Cycle"
-    bl_options = {"REGISTER", "UNDO"}
 
     period: bpy.props.FloatProperty(
         name="Period", default=0.0, min=0.0,
@@ -93,20 +93,11 @@ class TWIST_OT_make_cycle(bpy.types.Operator):
         description="Walk on the spot; off, the root travels on by one cycle's distance each "
                     "repetition")
 
-    @classmethod
-    def poll(cls, context):
-        return context.scene.twist.armature is not None
-
-    def execute(self, context):
+    def run(self, context) -> str:
         scene = context.scene
-        try:
-            start, n = make_cycle(scene.twist.armature, scene.frame_start, scene.frame_end,
-                                  self.period or None, self.blend, self.in_place)
-        except (BridgeError, ValueError) as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"a cycle of {n} frames from frame {start}, repeating")
-        return {"FINISHED"}
+        start, n = make_cycle(scene.twist.armature, scene.frame_start, scene.frame_end,
+                              self.period or None, self.blend, self.in_place)
+        return f"a cycle of {n} frames from frame {start}, repeating"
 
 
 CLASSES = (TWIST_OT_make_cycle,)

@@ -25,6 +25,7 @@ from .bridge import (
     skeleton_from_armature,
     view_from_camera,
 )
+from .reporting import ArmatureAction
 
 
 def read_markers_csv(path: Path, scene) -> int:
@@ -90,12 +91,11 @@ def fit_armature(scene) -> float:
     return res.residual_px
 
 
-class TWIST_OT_import_markers(bpy.types.Operator):
+class TWIST_OT_import_markers(ArmatureAction, bpy.types.Operator):
     """Read joint markers from a CSV file of view, bone, x, y rows (pixels, y down)"""
 
     bl_idname = "twist.import_markers"
     bl_label = "Import Markers"
-    bl_options = {"REGISTER", "UNDO"}
 
     filepath: bpy.props.StringProperty(name="CSV File", subtype="FILE_PATH",
                                        description="The markers: view, bone, x, y per row")
@@ -104,36 +104,21 @@ class TWIST_OT_import_markers(bpy.types.Operator):
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}
 
-    def execute(self, context):
-        try:
-            n = read_markers_csv(Path(bpy.path.abspath(self.filepath)), context.scene)
-        except (BridgeError, OSError) as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"read {n} markers")
-        return {"FINISHED"}
+    def run(self, context) -> str:
+        n = read_markers_csv(Path(bpy.path.abspath(self.filepath)), context.scene)
+        return f"read {n} markers"
 
 
-class TWIST_OT_fit_pose(bpy.types.Operator):
+class TWIST_OT_fit_pose(ArmatureAction, bpy.types.Operator):
     """Pose the armature on the current frame so that its joints land on the markers"""
 
     bl_idname = "twist.fit_pose"
     bl_label = "Fit Pose to Markers"
-    bl_options = {"REGISTER", "UNDO"}
 
-    @classmethod
-    def poll(cls, context):
-        return context.scene.twist.armature is not None
-
-    def execute(self, context):
-        try:
-            rms = fit_armature(context.scene)
-        except BridgeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
+    def run(self, context) -> str:
+        rms = fit_armature(context.scene)
         context.view_layer.update()
-        self.report({"INFO"}, f"fitted: joints {rms:.1f} px from their markers (RMS)")
-        return {"FINISHED"}
+        return f"fitted: joints {rms:.1f} px from their markers (RMS)"
 
 
 CLASSES = (TWIST_OT_import_markers, TWIST_OT_fit_pose)

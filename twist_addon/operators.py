@@ -12,15 +12,12 @@ from pathlib import Path
 
 import bpy
 
-from ..core.image import ImageError
-from ..core.job import JobError
 from ..core.video import is_video
-from .bridge import BridgeError, armature_from_skeleton, skeleton_from_armature
+from .bridge import armature_from_skeleton, skeleton_from_armature
 from .keyframes import clear
 from .properties import first_frame_property
+from .reporting import EXPECTED, ArmatureAction
 from .track import TrackSession
-
-_EXPECTED = (BridgeError, ImageError, JobError, ValueError)
 
 
 def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
@@ -37,25 +34,20 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
     return {"INFO"}, msg
 
 
-class TWIST_OT_track(bpy.types.Operator):
+class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
     """Track the armature through the footage of every view, keying each tracked frame"""
 
     bl_idname = "twist.track"
     bl_label = "Track"
-    bl_options = {"REGISTER", "UNDO"}
 
     _timer = None
     _session = None
     _steps = None
 
-    @classmethod
-    def poll(cls, context):
-        return context.scene is not None and context.scene.twist.armature is not None
-
     def _start(self, context) -> bool:
         try:
             self._session = TrackSession.from_scene(context.scene)
-        except _EXPECTED as e:
+        except EXPECTED as e:
             self.report({"ERROR"}, str(e))
             return False
         self._steps = self._session.run()
@@ -78,7 +70,7 @@ class TWIST_OT_track(bpy.types.Operator):
         try:
             for _ in self._steps:
                 pass
-        except _EXPECTED as e:
+        except EXPECTED as e:
             self.report({"ERROR"}, str(e))
         return self._finish(context, cancelled=False)
 
@@ -100,7 +92,7 @@ class TWIST_OT_track(bpy.types.Operator):
             res = next(self._steps)
         except StopIteration:
             return self._end_modal(context, cancelled=False)
-        except _EXPECTED as e:
+        except EXPECTED as e:
             self.report({"ERROR"}, str(e))
             return self._end_modal(context, cancelled=True)
         n = len(self._session.tracked)
@@ -118,26 +110,16 @@ class TWIST_OT_track(bpy.types.Operator):
         return self._finish(context, cancelled)
 
 
-class TWIST_OT_clear_track(bpy.types.Operator):
+class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
     """Remove the keyframes tracking wrote on the armature, and no other"""
 
     bl_idname = "twist.clear_track"
     bl_label = "Clear Track"
-    bl_options = {"REGISTER", "UNDO"}
 
-    @classmethod
-    def poll(cls, context):
-        return context.scene is not None and context.scene.twist.armature is not None
-
-    def execute(self, context):
+    def run(self, context) -> str:
         arm = context.scene.twist.armature
-        try:
-            n = clear(arm, skeleton_from_armature(arm))
-        except BridgeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"removed {n} tracked keyframes from '{arm.name}'")
-        return {"FINISHED"}
+        n = clear(arm, skeleton_from_armature(arm))
+        return f"removed {n} tracked keyframes from '{arm.name}'"
 
 
 TEMPLATES = {
