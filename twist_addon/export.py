@@ -68,8 +68,9 @@ class TWIST_OT_export_fbx(_Export, bpy.types.Operator):
     def export(self, context, scene):
         return bpy.ops.export_scene.fbx(
             filepath=self.filepath, use_selection=True, object_types={"ARMATURE"},
-            add_leaf_bones=False, bake_anim=True, bake_anim_use_all_actions=False,
-            bake_anim_use_nla_strips=False, bake_anim_simplify_factor=0.0,
+            use_armature_deform_only=True, add_leaf_bones=False, bake_anim=True,
+            bake_anim_use_all_actions=False, bake_anim_use_nla_strips=False,
+            bake_anim_simplify_factor=0.0,
             bake_anim_force_startend_keying=True)
 
 
