@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import body, cycle, export, fit, operators, overlay, panels, properties
+from . import body, cycle, export, fit, operators, overlay, panels, properties, retarget
 
-MODULES = (properties, operators, fit, body, cycle, export, panels, overlay)
+MODULES = (properties, operators, fit, body, cycle, retarget, export, panels, overlay)
 
 
 def register():

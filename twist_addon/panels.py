@@ -71,6 +71,7 @@ class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
         layout.operator("twist.clear_track", icon="X")
         layout.operator("twist.make_cycle", icon="FILE_REFRESH")
         layout.operator("twist.add_volumetric_body", icon="MESH_UVSPHERE")
+        layout.operator("twist.retarget", icon="ARMATURE_DATA")
         row = layout.row(align=True)
         row.operator("twist.export_bvh", text="BVH", icon="EXPORT")
         row.operator("twist.export_fbx", text="FBX", icon="EXPORT")

@@ -1,0 +1,151 @@
+"""Copying tracked motion onto another armature through a bone map.
+
+Each mapped target bone is turned in the world the way its source bone turned from its own
+rest pose (R_target = D R_target_rest with D = R_source R_source_rest^T, world rotations), so
+different rest poses and bone rolls carry over; unmapped bones follow their parents. The root
+travels as the source's root did, scaled by the ratio of the two legs' lengths.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+from .bridge import BridgeError
+from .reporting import ArmatureAction
+
+_PRESET_ITEMS = [("CMU", "CMU / BVH", "Bone names of the CMU motion capture BVH files"),
+                 ("RIGIFY", "Rigify", "Blender's Rigify human metarig"),
+                 ("MIXAMO", "Mixamo", "Mixamo's mixamorig: names")]
+_LABEL = {"CMU": "CMU", "RIGIFY": "Rigify", "MIXAMO": "Mixamo"}
+
+# body part -> bone name in each naming scheme
+ROLES = {
+    "hips": ("Hips", "spine", "mixamorig:Hips"),
+    "spine": ("lowerback", "spine.001", "mixamorig:Spine"),
+    "chest": ("Chest", "spine.002", "mixamorig:Spine1"),
+    "upper_chest": ("Chest2", "spine.003", "mixamorig:Spine2"),
+    "neck": ("Neck", "spine.004", "mixamorig:Neck"),
+    "head": ("Head", "spine.006", "mixamorig:Head"),
+}
+for _s, _r, _m in (("Left", "L", "Left"), ("Right", "R", "Right")):
+    ROLES.update({
+        f"thigh_{_r}": (f"{_s}Hip", f"thigh.{_r}", f"mixamorig:{_m}UpLeg"),
+        f"shin_{_r}": (f"{_s}Knee", f"shin.{_r}", f"mixamorig:{_m}Leg"),
+        f"foot_{_r}": (f"{_s}Ankle", f"foot.{_r}", f"mixamorig:{_m}Foot"),
+        f"toe_{_r}": (f"{_s}Toe", f"toe.{_r}", f"mixamorig:{_m}ToeBase"),
+        f"clavicle_{_r}": (f"{_s}Collar", f"shoulder.{_r}", f"mixamorig:{_m}Shoulder"),
+        f"upper_arm_{_r}": (f"{_s}Shoulder", f"upper_arm.{_r}", f"mixamorig:{_m}Arm"),
+        f"forearm_{_r}": (f"{_s}Elbow", f"forearm.{_r}", f"mixamorig:{_m}ForeArm"),
+        f"hand_{_r}": (f"{_s}Wrist", f"hand.{_r}", f"mixamorig:{_m}Hand"),
+    })
+PRESETS = {"CMU": 0, "RIGIFY": 1, "MIXAMO": 2}
+
+
+def bone_map(source_preset: str, target_preset: str) -> dict[str, str]:
+    """Source bone name -> target bone name for every role both presets name."""
+    s, t = PRESETS[source_preset], PRESETS[target_preset]
+    return {names[s]: names[t] for names in ROLES.values()}
+
+
+def _rot(m) -> np.ndarray:
+    a = np.array([list(r) for r in m], dtype=float)[:3, :3]
+    return a / np.linalg.norm(a, axis=0)
+
+
+def _leg_length(arm, preset: str) -> float:
+    """Thigh plus shin (left), world units."""
+    i = PRESETS[preset]
+    b = arm.data.bones
+    names = (ROLES["thigh_L"][i], ROLES["shin_L"][i])
+    if not all(n in b for n in names):
+        raise BridgeError(f"'{arm.name}' has no {' and '.join(names)}: is it a "
+                          f"{_LABEL[preset]} armature?")
+    return float(np.linalg.norm(np.array(arm.matrix_world)[:3, 0]) * sum(b[n].length
+                                                                          for n in names))
+
+
+def retarget(source, target, source_preset: str, target_preset: str, frames: list[int],
+             scene) -> int:
+    """Key ``target`` on ``frames`` with the motion of ``source``; returns the bones mapped."""
+    mapping = bone_map(source_preset, target_preset)
+    pairs = {t: s for s, t in mapping.items()
+             if s in source.data.bones and t in target.data.bones}
+    if not pairs:
+        raise BridgeError(f"no bone of the {_LABEL[source_preset]} to {_LABEL[target_preset]} "
+                          f"map is in both '{source.name}' and '{target.name}'")
+    ratio = _leg_length(target, target_preset) / _leg_length(source, source_preset)
+    src_root = next(b.name for b in source.data.bones if b.parent is None)
+    tgt_root = next(b.name for b in target.data.bones if b.parent is None)
+    S_obj, T_obj = _rot(source.matrix_world), _rot(target.matrix_world)
+    rest_s = {b.name: S_obj @ _rot(b.matrix_local) for b in source.data.bones}
+    rest_t = {b.name: _rot(b.matrix_local) for b in target.data.bones}
+    for b in target.pose.bones:
+        b.rotation_mode = "QUATERNION"
+    for f in frames:
+        scene.frame_set(f)
+        pose = {}
+        for b in target.data.bones:  # parents come first in this order
+            if b.name in pairs:
+                s = pairs[b.name]
+                D = S_obj @ _rot(source.pose.bones[s].matrix) @ rest_s[s].T
+                pose[b.name] = T_obj.T @ D @ T_obj @ rest_t[b.name]
+            elif b.parent is not None:
+                pose[b.name] = pose[b.parent.name] @ rest_t[b.parent.name].T @ rest_t[b.name]
+            else:
+                pose[b.name] = rest_t[b.name]
+            parent = (pose[b.parent.name] @ rest_t[b.parent.name].T if b.parent is not None
+                      else np.eye(3))
+            basis = rest_t[b.name].T @ parent.T @ pose[b.name]
+            pb = target.pose.bones[b.name]
+            pb.rotation_quaternion = Matrix(basis.tolist()).to_quaternion()
+            pb.keyframe_insert("rotation_quaternion", frame=f, group=b.name)
+        # the root travels like the source's, scaled by the legs
+        sp = source.pose.bones[src_root]
+        disp = np.array(source.matrix_world)[:3, :3] @ (np.array(sp.head)
+                                                         - np.array(sp.bone.head_local))
+        tb = target.pose.bones[tgt_root]
+        t_scale = np.linalg.norm(np.array(target.matrix_world)[:3, 0])
+        local = rest_t[tgt_root].T @ T_obj.T @ (disp * ratio) / t_scale
+        tb.location = local
+        tb.keyframe_insert("location", frame=f, group=tgt_root)
+    return len(pairs)
+
+
+class TWIST_OT_retarget(ArmatureAction, bpy.types.Operator):
+    """Copy the tracked motion onto another armature through a bone map, over the scene's
+    frame range"""
+
+    bl_idname = "twist.retarget"
+    bl_label = "Retarget"
+
+    target: bpy.props.StringProperty(
+        name="Target", description="The armature object to key (by name)")
+    source_preset: bpy.props.EnumProperty(
+        name="Source Names", items=_PRESET_ITEMS, default="CMU",
+        description="How the tracked armature's bones are named")
+    target_preset: bpy.props.EnumProperty(
+        name="Target Names", items=_PRESET_ITEMS, default="RIGIFY",
+        description="How the target armature's bones are named")
+
+    def invoke(self, context, event):
+        return context.window_manager.invoke_props_dialog(self)
+
+    def draw(self, context):
+        self.layout.prop_search(self, "target", bpy.data, "objects")
+        self.layout.prop(self, "source_preset")
+        self.layout.prop(self, "target_preset")
+
+    def run(self, context) -> str:
+        scene = context.scene
+        target = bpy.data.objects.get(self.target)
+        if target is None or target.type != "ARMATURE":
+            raise BridgeError(f"no armature named '{self.target}' to retarget onto")
+        frames = list(range(scene.frame_start, scene.frame_end + 1))
+        n = retarget(scene.twist.armature, target, self.source_preset, self.target_preset,
+                     frames, scene)
+        return f"retargeted {n} bones onto '{target.name}' over {len(frames)} frames"
+
+
+CLASSES = (TWIST_OT_retarget,)
