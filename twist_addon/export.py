@@ -8,11 +8,36 @@ import bpy
 from bpy_extras.io_utils import ExportHelper
 
 
-def _armature(context):
+def _armature(context, name: str = ""):
+    """The armature named, else the tracked one, else the active object if an armature."""
+    if name:
+        obj = bpy.data.objects.get(name)
+        return obj if obj is not None and obj.type == "ARMATURE" else None
     arm = context.scene.twist.armature
     if arm is None and context.active_object and context.active_object.type == "ARMATURE":
         arm = context.active_object
     return arm
+
+
+def _frame_range(arm, scene, only_cycle: bool) -> tuple[int, int]:
+    """The scene's frame range, or with ``only_cycle`` the span of the armature's keys that
+    Make Walk Cycle left (the cycle repeats past them)."""
+    if not only_cycle:
+        return scene.frame_start, scene.frame_end
+    ad = arm.animation_data
+    if ad is None or ad.action is None:
+        raise ValueError(f"'{arm.name}' has no animation to export")
+    cycled = [fc for fc in _fcurves(ad) if any(m.type == "CYCLES" for m in fc.modifiers)]
+    if not cycled:
+        raise ValueError(f"'{arm.name}' has no cycle: use Make Walk Cycle first")
+    keys = [kp.co[0] for fc in cycled for kp in fc.keyframe_points]
+    return int(round(min(keys))), int(round(max(keys))) - 1  # the last key closes the loop
+
+
+def _fcurves(ad):
+    from bpy_extras import anim_utils
+
+    return anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot).fcurves
 
 
 def _select_only(context, obj) -> None:
@@ -27,19 +52,39 @@ def _select_only(context, obj) -> None:
 class _Export(ExportHelper):
     bl_options = {"REGISTER"}
 
+    armature: bpy.props.StringProperty(
+        name="Armature", description="The armature to export, by name (empty: the tracked "
+                                     "one); a retargeted rig, for instance")
+    only_cycle: bpy.props.BoolProperty(
+        name="Only One Cycle", default=False,
+        description="Export just the walk cycle's frames instead of the scene's range")
+
     @classmethod
     def poll(cls, context):
         return _armature(context) is not None
 
     def execute(self, context):
-        arm = _armature(context)
+        arm = _armature(context, self.armature)
         if arm is None:
-            self.report({"ERROR"}, "no armature to export: set Twist Mocap > Armature")
+            self.report({"ERROR"}, f"no armature '{self.armature}' to export" if self.armature
+                        else "no armature to export: set Twist Mocap > Armature")
+            return {"CANCELLED"}
+        try:
+            first, last = _frame_range(arm, context.scene, self.only_cycle)
+        except ValueError as e:
+            self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         _select_only(context, arm)
-        result = self.export(context, context.scene)
+        scene = context.scene
+        kept = scene.frame_start, scene.frame_end
+        scene.frame_start, scene.frame_end = first, last
+        try:
+            result = self.export(context, scene)
+        finally:
+            scene.frame_start, scene.frame_end = kept
         if result == {"FINISHED"}:
-            self.report({"INFO"}, f"exported '{arm.name}' to {self.filepath}")
+            self.report({"INFO"}, f"exported '{arm.name}' frames {first}-{last} to "
+                                  f"{self.filepath}")
         return result
 
 

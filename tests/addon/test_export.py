@@ -138,3 +138,23 @@ def test_fbx_round_trip_through_blender_and_ufbx(animated, tmp_path):
         assert len(common) >= 20
         assert _max_angle({k: dirs[k] for k in common},
                           {k: source[f - 1][k] for k in common}) < 0.1, f
+
+
+def test_export_one_cycle_of_a_chosen_armature(bpy_module, registered, tmp_path):
+    bpy = bpy_module
+    from support.walking import walking_template
+
+    scene, arm = walking_template(bpy, registered, frames=60)
+    assert bpy.ops.twist.make_cycle() == {"FINISHED"}
+    bag = registered.twist_addon.cycle._channelbag(arm)
+    keys = sorted({int(k.co[0]) for fc in bag.fcurves for k in fc.keyframe_points})
+    bpy.ops.twist.add_template_armature(template="WALKER")  # now the scene's tracked armature
+    out = tmp_path / "cycle.bvh"
+    assert bpy.ops.twist.export_bvh(filepath=str(out), armature=arm.name,
+                                    only_cycle=True) == {"FINISHED"}
+    got = read_bvh(out)
+    assert len(got.motion) == len(keys) - 1  # one period; its closing key is the next start
+    assert "LeftKnee" in got.names and "LeftAnkle" not in got.names  # the human, not the walker
+    assert (scene.frame_start, scene.frame_end) == (1, 60)  # the scene's range is untouched
+    with pytest.raises(RuntimeError, match="'Walker' has no animation to export"):
+        bpy.ops.twist.export_bvh(filepath=str(out), only_cycle=True)
