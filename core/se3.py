@@ -184,6 +184,14 @@ def twist_of_axis(omega: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.concatenate([-np.cross(omega, q), omega])
 
 
+def frame_along(u: np.ndarray) -> np.ndarray:
+    """Rows: the unit vector along u and two unit vectors across it, a right-handed frame."""
+    u = np.asarray(u, dtype=float) / np.linalg.norm(u)
+    v = np.cross(u, np.eye(3)[int(np.argmin(np.abs(u)))])
+    v /= np.linalg.norm(v)
+    return np.stack([u, v, np.cross(u, v)])
+
+
 def rotation_angle_between(R1: np.ndarray, R2: np.ndarray) -> np.ndarray:
     """Angle (radians) of R1^T R2, robust in float32 via atan2; works on stacks (..., 3, 3)."""
     D = np.swapaxes(R1, -1, -2) @ R2

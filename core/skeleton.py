@@ -111,10 +111,7 @@ class Skeleton:
         joint, else local x) and two perpendiculars, in the joint's local frame."""
         tips = [self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
         tips = [t for t in tips if np.linalg.norm(t) > 1e-9]
-        u = tips[0] / np.linalg.norm(tips[0]) if tips else np.array([1.0, 0, 0])
-        v = np.cross(u, np.eye(3)[int(np.argmin(np.abs(u)))])
-        v /= np.linalg.norm(v)
-        return np.stack([u, v, np.cross(u, v)])
+        return se3.frame_along(tips[0] if tips else np.array([1.0, 0, 0]))
 
     def dof_joints_and_axes(self) -> tuple[np.ndarray, np.ndarray]:
         """Per degree of freedom: its joint and unit axis in the joint's local frame. A ball's
@@ -203,14 +200,9 @@ class Skeleton:
 def bone_blob(joint: int, name: str, head: np.ndarray, direction: np.ndarray, r) -> Ellipsoid:
     """Ellipsoid along a bone from head to head + direction with short radii r (or (r1, r2))."""
     L = float(np.linalg.norm(direction))
-    u = direction / L
-    helper = np.eye(3)[int(np.argmin(np.abs(u)))]
-    v = np.cross(u, helper)
-    v /= np.linalg.norm(v)
-    w = np.cross(u, v)
     r1, r2 = np.broadcast_to(np.asarray(r, dtype=float), (2,))
     return Ellipsoid(
-        joint, name, head + direction / 2, np.array([L / 2, r1, r2]), np.stack([u, v, w], 1)
+        joint, name, head + direction / 2, np.array([L / 2, r1, r2]), se3.frame_along(direction).T
     )
 
 

@@ -5,19 +5,11 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy_extras import anim_utils
 
 from ..core.cycles import gait_period, make_loop
 from .bridge import BridgeError, skeleton_from_armature
-from .keyframes import TRACKED, channels
+from .keyframes import TRACKED, channelbag, tracked_fcurves
 from .reporting import ArmatureAction
-
-
-def _channelbag(arm):
-    ad = arm.animation_data
-    if ad is None or ad.action is None:
-        raise BridgeError(f"'{arm.name}' has no animation: track it first")
-    return anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot)
 
 
 def make_cycle(arm, first: int, last: int, period: float | None = None,
@@ -29,9 +21,10 @@ def make_cycle(arm, first: int, last: int, period: float | None = None,
     in place, or advances by one cycle's travel each repetition when ``in_place`` is False.
     """
     sk = skeleton_from_armature(arm)
-    bag = _channelbag(arm)
-    wanted = {(path, i) for _, path, i in channels(arm, sk)}
-    curves = [fc for fc in bag.fcurves if (fc.data_path, fc.array_index) in wanted]
+    bag = channelbag(arm)
+    if bag is None:
+        raise BridgeError(f"'{arm.name}' has no animation: track it first")
+    curves = tracked_fcurves(arm, sk, bag)
     if not curves:
         raise BridgeError(f"'{arm.name}' has no tracked keyframes to make a cycle of")
     frames = np.arange(first, last + 1)

@@ -7,6 +7,8 @@ from __future__ import annotations
 import bpy
 from bpy_extras.io_utils import ExportHelper
 
+from .keyframes import channelbag
+
 
 def _armature(context, name: str = ""):
     """The armature named, else the tracked one, else the active object if an armature."""
@@ -24,20 +26,15 @@ def _frame_range(arm, scene, only_cycle: bool) -> tuple[int, int]:
     Make Walk Cycle left (the cycle repeats past them)."""
     if not only_cycle:
         return scene.frame_start, scene.frame_end
-    ad = arm.animation_data
-    if ad is None or ad.action is None:
+    bag = channelbag(arm)
+    if bag is None:
         raise ValueError(f"'{arm.name}' has no animation to export")
-    cycled = [fc for fc in _fcurves(ad) if any(m.type == "CYCLES" for m in fc.modifiers)]
+    cycled = [fc for fc in bag.fcurves if any(m.type == "CYCLES" for m in fc.modifiers)]
     if not cycled:
         raise ValueError(f"'{arm.name}' has no cycle: use Make Walk Cycle first")
     keys = [kp.co[0] for fc in cycled for kp in fc.keyframe_points]
     return int(round(min(keys))), int(round(max(keys))) - 1  # the last key closes the loop
 
-
-def _fcurves(ad):
-    from bpy_extras import anim_utils
-
-    return anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot).fcurves
 
 
 def _select_only(context, obj) -> None:

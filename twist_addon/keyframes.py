@@ -60,22 +60,30 @@ def write_pose(arm, sk: Skeleton, frame: int, R: np.ndarray, root: np.ndarray) -
             pb.keyframe_insert("location", frame=frame, group=name, keytype=TRACKED)
 
 
-def clear(arm, sk: Skeleton, frames: set[int] | None = None) -> int:
-    """Remove tracked keys (of the given frames, or all) from the tracked channels; returns how
-    many were removed. Keys the user set are kept."""
+def channelbag(arm):
+    """Where the armature's F-curves live (its action's slot), or None without animation."""
     from bpy_extras import anim_utils
 
     ad = arm.animation_data
     if ad is None or ad.action is None:
-        return 0
-    bag = anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot)
+        return None
+    return anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot)
+
+
+def tracked_fcurves(arm, sk: Skeleton, bag) -> list:
+    """The F-curves of ``bag`` on the channels tracking keys (see ``channels``)."""
+    wanted = {(path, i) for _, path, i in channels(arm, sk)}
+    return [fc for fc in bag.fcurves if (fc.data_path, fc.array_index) in wanted]
+
+
+def clear(arm, sk: Skeleton, frames: set[int] | None = None) -> int:
+    """Remove tracked keys (of the given frames, or all) from the tracked channels; returns how
+    many were removed. Keys the user set are kept."""
+    bag = channelbag(arm)
     if bag is None:
         return 0
-    wanted = {(path, i) for _, path, i in channels(arm, sk)}
     removed = 0
-    for fc in list(bag.fcurves):
-        if (fc.data_path, fc.array_index) not in wanted:
-            continue
+    for fc in tracked_fcurves(arm, sk, bag):
         for kp in reversed(list(fc.keyframe_points)):
             f = int(round(kp.co[0]))
             if kp.type == TRACKED and (frames is None or f in frames):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.raycast import blob_frames
+from ..core.se3 import frame_along
 from ..core.skeleton import Skeleton
 
 _HANDLE = None
@@ -23,11 +24,7 @@ def silhouette_loops(sk: Skeleton, R: np.ndarray, root: np.ndarray, view_dir: np
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     out = np.empty((len(sk.blobs), n, 3))
     for i in range(len(sk.blobs)):
-        e = A[i] @ view_dir
-        e /= np.linalg.norm(e)
-        a = np.cross(e, np.eye(3)[int(np.argmin(np.abs(e)))])
-        a /= np.linalg.norm(a)
-        b = np.cross(e, a)
+        _, a, b = frame_along(A[i] @ view_dir)  # the great circle across the view
         Y = np.cos(t)[:, None] * a + np.sin(t)[:, None] * b
         out[i] = np.linalg.solve(A[i], Y.T).T + C[i]
     return out

@@ -10,7 +10,7 @@ def test_make_cycle_finds_the_period_and_loops_seamlessly(bpy_module, registered
     bpy = bpy_module
     scene, arm = walking_template(bpy, registered)
     assert bpy.ops.twist.make_cycle() == {"FINISHED"}
-    bag = registered.twist_addon.cycle._channelbag(arm)
+    bag = registered.twist_addon.keyframes.channelbag(arm)
     curves = [fc for fc in bag.fcurves]
     assert curves and all(fc.modifiers and fc.modifiers[0].type == "CYCLES" for fc in curves)
     n = len(curves[0].keyframe_points) - 1  # the last key closes the cycle
@@ -29,7 +29,7 @@ def test_make_cycle_finds_the_period_and_loops_seamlessly(bpy_module, registered
 def test_make_cycle_can_keep_walking_forward(bpy_module, registered):
     bpy = bpy_module
     scene, arm = walking_template(bpy, registered)
-    bag = registered.twist_addon.cycle._channelbag(arm)
+    bag = registered.twist_addon.keyframes.channelbag(arm)
     root_y = max((fc for fc in bag.fcurves if fc.data_path.endswith("location")),
                  key=lambda fc: abs(fc.evaluate(70) - fc.evaluate(1)))  # the walking direction
     direction = np.sign(root_y.evaluate(70) - root_y.evaluate(1))

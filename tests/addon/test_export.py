@@ -146,7 +146,7 @@ def test_export_one_cycle_of_a_chosen_armature(bpy_module, registered, tmp_path)
 
     scene, arm = walking_template(bpy, registered, frames=60)
     assert bpy.ops.twist.make_cycle() == {"FINISHED"}
-    bag = registered.twist_addon.cycle._channelbag(arm)
+    bag = registered.twist_addon.keyframes.channelbag(arm)
     keys = sorted({int(k.co[0]) for fc in bag.fcurves for k in fc.keyframe_points})
     bpy.ops.twist.add_template_armature(template="WALKER")  # now the scene's tracked armature
     out = tmp_path / "cycle.bvh"
