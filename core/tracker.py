@@ -181,6 +181,8 @@ class Tracker:
         for b in skeleton.blobs:
             thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
         self.dof_thickness = thin[skeleton.dof_joints_and_axes()[0]]
+        self._blob_joints = np.array([b.joint for b in skeleton.blobs], dtype=int)
+        self._blob_centres = np.array([b.centre for b in skeleton.blobs])
 
 
     def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
@@ -203,7 +205,7 @@ class Tracker:
         )
         ok = hits.label >= 0
         pix_l, label = pix_l[ok].astype(int), hits.label[ok]
-        seg_joint = np.array([b.joint for b in self.skeleton.blobs], dtype=int)[label]
+        seg_joint = self._blob_joints[label]
         g = kin.segments[seg_joint]
         d = hits.world[ok] - g[:, :3, 3]
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
@@ -296,14 +298,10 @@ class Tracker:
             return ""
         return "the body left the image of view " + ", ".join(str(c + 1) for c in gone)
 
-    def _blob_pixels(self, pose: BodyPose) -> np.ndarray:
+    def _blob_pixels(self, kin: Kinematics) -> np.ndarray:
         """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
-        g = self.skeleton.segment_motions(
-            self.skeleton.joint_frames(pose.rotations, pose.root_position)
-        )
-        centres = np.array([g[b.joint, :3, :3] @ b.centre + g[b.joint, :3, 3]
-                            for b in self.skeleton.blobs])
-        return np.array([v.project(centres) for v in pose.views])
+        centres = kin.world_points(self._blob_joints, self._blob_centres)
+        return np.array([v.project(centres) for v in kin.pose.views])
 
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
                     predicted: BodyPose, frame: int) -> FrameResult:
@@ -350,8 +348,8 @@ class Tracker:
                 old = float(np.sum(smp.costs[both]) + prior @ offset**2)
                 new = float(np.sum(c_smp.costs[both]) + prior @ (offset + delta) ** 2)
                 if new <= old:
-                    moved = np.max(np.linalg.norm(self._blob_pixels(cand) - self._blob_pixels(est),
-                                                  axis=-1))
+                    moved = np.max(np.linalg.norm(self._blob_pixels(kin_c)
+                                                  - self._blob_pixels(kin), axis=-1))
                     est, kin, smp = cand, kin_c, c_smp
                     offset = offset + delta
                     lam = max(lam / 3, 1e-6)
