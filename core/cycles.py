@@ -1,8 +1,8 @@
-"""Walk cycles from tracked motion: the gait period, a half cycle completed by mirroring, a
-seamless loop, and zero-phase smoothing.
+"""Walk cycles from tracked motion: the gait period, a partial cycle completed by mirroring
+left and right, a seamless loop, and zero-phase smoothing.
 
 Curves are arrays (frames, channels) sampled at a fixed rate; rotations are unit quaternions
-(frames, 4). Which channels are the left and which the right side is the caller's to say.
+(frames, 4) or 3x3 matrices. Which joints pair across the body is the caller's to say.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def gait_period(curves: np.ndarray, min_frames: int = 4) -> float:
     return float(k)
 
 
-def _sample(curve: np.ndarray, t: np.ndarray) -> np.ndarray:
+def sample(curve: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Linear interpolation of a curve (F, C) at fractional frames t (clamped)."""
     F = len(curve)
     t = np.clip(t, 0, F - 1)
@@ -45,24 +45,48 @@ def _sample(curve: np.ndarray, t: np.ndarray) -> np.ndarray:
     return curve[i] * (1 - f) + curve[i + 1] * f
 
 
-def mirror_half_cycle(left: np.ndarray, right: np.ndarray, period: float,
-                      mirror: Callable[[np.ndarray], np.ndarray] = lambda c: c
-                      ) -> tuple[np.ndarray, np.ndarray]:
+def complete_by_mirroring(curves: np.ndarray, period: float,
+                          mirror: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     """Complete a gait recorded over less than a cycle (the paper completed a 60 % walk this
-    way): each side at frame t moves as the other side did at t - period / 2, passed through
-    ``mirror`` (which maps one side's channels onto the other's, e.g. flipping the sign of
-    sideways angles). left, right: (F, C) with F >= period / 2. Returns both sides over one
-    period (round(period) frames): recorded frames as they were, the rest filled in."""
+    way): at frame t past the recording the body moves as it did at t - period / 2, mirrored.
+    ``curves`` (F, C) hold every channel of the body, F >= period / 2; ``mirror`` maps rows
+    (k, C) onto the mirrored body's rows (sides swapped and reflected, see ``mirror_poses``).
+    Returns one period (round(period) rows): the recorded frames as they were, then the rest."""
     half = period / 2
-    F = len(left)
+    F = len(curves)
     if F < half:
         raise ValueError(f"{F} frames are less than half a period ({half:.1f} frames)")
-    n = int(round(period))
-    t = np.arange(n, dtype=float)
-    have = t < F
-    out_l = np.concatenate([left[: have.sum()], mirror(_sample(right, t[~have] - half))])
-    out_r = np.concatenate([right[: have.sum()], mirror(_sample(left, t[~have] - half))])
-    return out_l, out_r
+    t = np.arange(F, int(round(period)), dtype=float)
+    recorded = np.asarray(curves, float)[: int(round(period))]
+    if not len(t):
+        return recorded
+    return np.concatenate([recorded, mirror(sample(recorded, t - half))])
+
+
+def reflection(normal: np.ndarray) -> np.ndarray:
+    """3x3 reflection across the plane through the origin with the given normal."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    return np.eye(3) - 2 * np.outer(n, n)
+
+
+def mirror_poses(turns: np.ndarray, root: np.ndarray, partners: np.ndarray,
+                 normal: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The body's mirror image across its sagittal plane, pose by pose.
+
+    turns (k, J, 3, 3): each joint's rotation from its rest pose, written in the body's rest
+    axes (the rest body symmetric across x = 0), so that a joint's world orientation is the
+    product of the turns from the root down; joint 0 is the root, whose turn also carries the
+    heading. root (k, 3): the root's position. partners (J,): each joint's other-side joint
+    (itself on the midline). normal, centre: the sagittal plane the motion is mirrored across,
+    in the root's parent axes. Joint j of the mirror image turns as S turns[partners[j]] S
+    (S flips rest x); the root as S_p turns[0] S (S_p reflects across the plane); its position
+    is reflected across the plane."""
+    S = np.diag([-1.0, 1.0, 1.0])
+    Sp = reflection(normal)
+    out = S @ turns[:, partners] @ S
+    out[:, 0] = Sp @ turns[:, 0] @ S
+    c = np.asarray(centre, float)
+    return out, c + (np.asarray(root, float) - c) @ Sp.T
 
 
 def make_loop(cycle: np.ndarray, blend: int) -> np.ndarray:

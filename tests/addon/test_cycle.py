@@ -47,3 +47,71 @@ def test_make_cycle_needs_tracked_motion(bpy_module, registered):
     bpy.ops.twist.add_template_armature(template="HUMAN")
     with pytest.raises(RuntimeError, match="has no animation: track it first"):
         bpy.ops.twist.make_cycle()
+
+
+def _bone_rotations(arm, bag, frames):
+    """Each tracked bone's rotation per frame as a quaternion (w, x, y, z), from its curves."""
+    from mathutils import Euler, Quaternion
+
+    out = {}
+    for pb in arm.pose.bones:
+        path = f'pose.bones["{pb.name}"].rotation_'
+        quat = sorted((fc for fc in bag.fcurves if fc.data_path == path + "quaternion"),
+                      key=lambda c: c.array_index)
+        euler = [fc for fc in bag.fcurves if fc.data_path == path + "euler"]
+        rows = []
+        for f in frames:
+            if quat:
+                q = Quaternion([fc.evaluate(f) for fc in quat])
+            elif euler:
+                e = Euler(pb.rotation_euler, pb.rotation_mode)
+                for fc in euler:
+                    e[fc.array_index] = fc.evaluate(f)
+                q = e.to_quaternion()
+            else:
+                break
+            rows.append(np.array(q.normalized()))
+        if rows:
+            out[pb.name] = np.array(rows)
+    return out
+
+
+def test_mirroring_completes_sixty_percent_of_a_walk_within_half_a_degree(bpy_module,
+                                                                          registered):
+    """The walk keyed over 60 % of a cycle only; the rest of the cycle filled in by mirroring
+    against the walk as it was keyed (its legs swing and sway sideways, its root bobs, sways
+    and travels; the knees' rolls are not mirror images)."""
+    bpy = bpy_module
+    scene, arm = walking_template(bpy, registered)
+    tw = registered.twist_addon
+    bag = tw.keyframes.channelbag(arm)
+    n = int(round(PERIOD))
+    frames = range(1, n - 1)  # before the last frames, which bridge into the cycle's start
+    truth = _bone_rotations(arm, bag, frames)
+    root_loc = [fc for fc in bag.fcurves if fc.data_path.endswith("location")]
+    truth_loc = np.array([[fc.evaluate(f) for fc in root_loc] for f in frames])
+    scene.frame_end = int(0.6 * PERIOD)
+    assert bpy.ops.twist.make_cycle(mirror=True, period=PERIOD, blend=1,
+                                    in_place=False) == {"FINISHED"}
+    got = _bone_rotations(arm, bag, frames)
+    assert set(got) == set(truth) and len(truth) >= 10
+    for bone, q in truth.items():
+        err = np.degrees(2 * np.arccos(np.clip(np.abs(np.sum(q * got[bone], 1)), 0, 1)))
+        assert err.max() < 0.5, (bone, err.round(2))
+    loc = np.array([[fc.evaluate(f) for fc in root_loc] for f in frames])
+    np.testing.assert_allclose(loc, truth_loc, atol=2e-3)
+    assert int(root_loc[0].keyframe_points[0].co[0]) == 1  # the cycle starts with the range
+
+
+def test_mirroring_needs_paired_bones_and_half_a_cycle(bpy_module, registered):
+    bpy = bpy_module
+    scene, arm = walking_template(bpy, registered)
+    scene.frame_end = int(0.4 * PERIOD)
+    with pytest.raises(RuntimeError, match="less than half of a 24-frame cycle"):
+        bpy.ops.twist.make_cycle(mirror=True, period=PERIOD)
+    with pytest.raises(RuntimeError, match="set the Period"):
+        bpy.ops.twist.make_cycle(mirror=True)
+    scene.frame_end = int(0.6 * PERIOD)
+    arm.data.bones["RightKnee"].name = "Knee2"
+    with pytest.raises(RuntimeError, match="'LeftKnee' has no tracked partner 'RightKnee'"):
+        bpy.ops.twist.make_cycle(mirror=True, period=PERIOD)

@@ -5,8 +5,15 @@ import pytest
 
 from core import se3
 from core.bvh import read_bvh
-from core.cycles import gait_period, lowpass, lowpass_quaternions, make_loop, mirror_half_cycle
-from core.skeleton import skeleton_from_bvh
+from core.cycles import (
+    complete_by_mirroring,
+    gait_period,
+    lowpass,
+    lowpass_quaternions,
+    make_loop,
+    mirror_poses,
+)
+from core.skeleton import human_template, skeleton_from_bvh
 
 
 def _gait(t, period):
@@ -54,19 +61,41 @@ def test_mirroring_completes_a_symmetric_gait_within_half_a_degree():
         return np.stack([_gait(t - shift, period), 5 * np.sin(2 * np.pi * (t - shift) / period)],
                         1)
 
-    def mirror(c):
-        return c * [1, -1]
+    def mirror(rows):  # swap the sides, flip the sideways channels
+        return rows[:, [2, 3, 0, 1]] * [1, -1, 1, -1]
 
     left = side(t, 0)
-    right = mirror(side(t, period / 2))  # the right side: the left half a period later
-    rec = int(0.6 * period)  # 60 % of a cycle recorded, as in the paper's Muybridge walk
-    got_l, got_r = mirror_half_cycle(left[:rec], right[:rec], period, mirror)
+    body = np.hstack([left, side(t, period / 2) * [1, -1]])  # the right: the left half a
+    rec = int(0.6 * period)  # period later, mirrored; 60 % recorded, as in the paper's walk
+    got = complete_by_mirroring(body[:rec], period, mirror)
     n = int(round(period))
-    np.testing.assert_allclose(got_l, left[:n], atol=0.5)
-    np.testing.assert_allclose(got_r, right[:n], atol=0.5)
-    np.testing.assert_array_equal(got_l[:rec], left[:rec])  # recorded frames kept as they were
+    np.testing.assert_allclose(got, body[:n], atol=0.5)
+    np.testing.assert_array_equal(got[:rec], body[:rec])  # recorded frames kept as they were
     with pytest.raises(ValueError, match="less than half a period"):
-        mirror_half_cycle(left[:10], right[:10], period)
+        complete_by_mirroring(body[:10], period, mirror)
+
+
+def test_mirrored_poses_put_each_joint_where_its_partner_is_seen_in_a_mirror():
+    """Forward kinematics of the mirrored pose against the reflected joint positions of the
+    original, for a body turned away from the axes (so the plane is not the rest x = 0)."""
+    sk = human_template()
+    rng = np.random.default_rng(3)
+    k = 4
+    turns = np.stack([[se3.exp_so3(rng.normal(0, 0.5, 3)) for _ in sk.names]
+                      for _ in range(k)])
+    heading = se3.exp_so3(np.array([0.0, 0.7, 0.0]))  # templates are y up
+    turns[:, 0] = heading @ turns[:, 0]
+    root = rng.normal(0, 1, (k, 3))
+    partners = np.array([sk.index(n.replace("Left", "#").replace("Right", "Left")
+                                  .replace("#", "Right")) for n in sk.names])
+    normal, centre = heading @ [1.0, 0, 0], np.array([0.3, 0.0, -0.2])
+    got, got_root = mirror_poses(turns, root, partners, normal, centre)
+    S = np.eye(3) - 2 * np.outer(normal, normal)
+    for f in range(k):
+        X = sk.world_positions(turns[f], root[f])
+        Y = sk.world_positions(got[f], got_root[f])
+        np.testing.assert_allclose(Y[partners], centre + (X - centre) @ S.T, atol=1e-9)
+        assert all(abs(np.linalg.det(r) - 1) < 1e-9 for r in got[f])
 
 
 def test_a_looped_cycle_repeats_smoothly_in_value_and_slope():
