@@ -79,6 +79,15 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
     markers: bpy.props.CollectionProperty(type=TWIST_PG_marker)
 
 
+class TWIST_PG_bone_pair(bpy.types.PropertyGroup):
+    """One line of the retargeting bone map."""
+
+    source: bpy.props.StringProperty(
+        name="Source", description="A bone of the tracked armature (the motion's source)")
+    target: bpy.props.StringProperty(
+        name="Target", description="The bone of the target armature that copies its motion")
+
+
 class TWIST_PG_result(bpy.types.PropertyGroup):
     """What the last Track run did, for the Results panel."""
 
@@ -115,6 +124,12 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
         name="Show Blobs", default=True,
         description="Draw the outline of every blob over the viewport, to line the armature up "
                     "with the footage through each view's camera")
+    bone_map: bpy.props.CollectionProperty(
+        type=TWIST_PG_bone_pair, name="Bone Map",
+        description="Which target bone copies which tracked bone when retargeting; empty, "
+                    "the presets' names are used")
+    active_bone_pair: bpy.props.IntProperty(name="Active Pair",
+                                            description="The selected line of the bone map")
     direction: bpy.props.EnumProperty(
         name="Direction", default="FORWARD",
         description="Which way to track from the current frame",
@@ -122,8 +137,8 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
                ("BACKWARD", "Backward", "From the current frame back to the scene's start")])
 
 
-CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_marker, TWIST_PG_view, TWIST_PG_result,
-           TWIST_PG_scene)
+CLASSES = (TWIST_PG_tracker_settings, TWIST_PG_marker, TWIST_PG_view, TWIST_PG_bone_pair,
+           TWIST_PG_result, TWIST_PG_scene)
 
 
 def register():

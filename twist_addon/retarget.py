@@ -3,7 +3,11 @@
 Each mapped target bone is turned in the world the way its source bone turned from its own
 rest pose (R_target = D R_target_rest with D = R_source R_source_rest^T, world rotations), so
 different rest poses and bone rolls carry over; unmapped bones follow their parents. The root
-travels as the source's root did, scaled by the ratio of the two legs' lengths.
+travels as the source's root did, scaled by the ratio of the two legs' lengths (each rest
+pose's root height above its lowest bone end).
+
+The bone map is the scene's editable list (``scene.twist.bone_map``), which the presets fill;
+while it is empty, the two presets chosen on the operator map the bones directly.
 """
 
 from __future__ import annotations
@@ -54,28 +58,29 @@ def _rot(m) -> np.ndarray:
     return a / np.linalg.norm(a, axis=0)
 
 
-def _leg_length(arm, preset: str) -> float:
-    """Thigh plus shin (left), world units."""
-    i = PRESETS[preset]
-    b = arm.data.bones
-    names = (ROLES["thigh_L"][i], ROLES["shin_L"][i])
-    if not all(n in b for n in names):
-        raise BridgeError(f"'{arm.name}' has no {' and '.join(names)}: is it a "
-                          f"{_LABEL[preset]} armature?")
-    return float(np.linalg.norm(np.array(arm.matrix_world)[:3, 0]) * sum(b[n].length
-                                                                          for n in names))
+def _leg_length(arm) -> float:
+    """The rest pose's root height above its lowest bone end (world units, world z up)."""
+    W = np.array(arm.matrix_world)
+    ends = np.array([(W @ np.append(np.array(p), 1))[:3]
+                     for b in arm.data.bones for p in (b.head_local, b.tail_local)])
+    root = next(b for b in arm.data.bones if b.parent is None)
+    height = (W @ np.append(np.array(root.head_local), 1))[2] - ends[:, 2].min()
+    if height < 1e-6:
+        raise BridgeError(f"the root of '{arm.name}' is its lowest point at rest: its legs "
+                          "cannot be measured to scale the travel")
+    return float(height)
 
 
-def retarget(source, target, source_preset: str, target_preset: str, frames: list[int],
-             scene) -> int:
-    """Key ``target`` on ``frames`` with the motion of ``source``; returns the bones mapped."""
-    mapping = bone_map(source_preset, target_preset)
+def retarget(source, target, mapping: dict[str, str], frames: list[int], scene,
+             map_name: str = "bone map") -> int:
+    """Key ``target`` on ``frames`` with the motion of ``source`` through ``mapping`` (source
+    bone -> target bone); returns the bones mapped."""
     pairs = {t: s for s, t in mapping.items()
              if s in source.data.bones and t in target.data.bones}
     if not pairs:
-        raise BridgeError(f"no bone of the {_LABEL[source_preset]} to {_LABEL[target_preset]} "
-                          f"map is in both '{source.name}' and '{target.name}'")
-    ratio = _leg_length(target, target_preset) / _leg_length(source, source_preset)
+        raise BridgeError(f"no bone of the {map_name} is in both '{source.name}' and "
+                          f"'{target.name}'")
+    ratio = _leg_length(target) / _leg_length(source)
     src_root = next(b.name for b in source.data.bones if b.parent is None)
     tgt_root = next(b.name for b in target.data.bones if b.parent is None)
     S_obj, T_obj = _rot(source.matrix_world), _rot(target.matrix_world)
@@ -143,9 +148,66 @@ class TWIST_OT_retarget(ArmatureAction, bpy.types.Operator):
         if target is None or target.type != "ARMATURE":
             raise BridgeError(f"no armature named '{self.target}' to retarget onto")
         frames = list(range(scene.frame_start, scene.frame_end + 1))
-        n = retarget(scene.twist.armature, target, self.source_preset, self.target_preset,
-                     frames, scene)
+        mapping = {p.source: p.target for p in scene.twist.bone_map if p.source and p.target}
+        if mapping:
+            name = "scene's bone map"
+        else:
+            mapping = bone_map(self.source_preset, self.target_preset)
+            name = f"{_LABEL[self.source_preset]} to {_LABEL[self.target_preset]} map"
+        n = retarget(scene.twist.armature, target, mapping, frames, scene, name)
         return f"retargeted {n} bones onto '{target.name}' over {len(frames)} frames"
 
 
-CLASSES = (TWIST_OT_retarget,)
+class TWIST_OT_load_bone_map(bpy.types.Operator):
+    """Fill the scene's bone map from two naming presets, to edit it before retargeting"""
+
+    bl_idname = "twist.load_bone_map"
+    bl_label = "Load Bone Map"
+    bl_options = {"REGISTER", "UNDO"}
+
+    source_preset: bpy.props.EnumProperty(
+        name="Source Names", items=_PRESET_ITEMS, default="CMU",
+        description="How the tracked armature's bones are named")
+    target_preset: bpy.props.EnumProperty(
+        name="Target Names", items=_PRESET_ITEMS, default="RIGIFY",
+        description="How the target armature's bones are named")
+
+    def invoke(self, context, event):
+        return context.window_manager.invoke_props_dialog(self)
+
+    def execute(self, context):
+        pairs = context.scene.twist.bone_map
+        pairs.clear()
+        for s, t in bone_map(self.source_preset, self.target_preset).items():
+            pair = pairs.add()
+            pair.source, pair.target = s, t
+        self.report({"INFO"}, f"{len(pairs)} bone pairs from the "
+                              f"{_LABEL[self.source_preset]} and "
+                              f"{_LABEL[self.target_preset]} names")
+        return {"FINISHED"}
+
+
+class TWIST_OT_edit_bone_map(bpy.types.Operator):
+    """Add a line to the scene's bone map, or remove the selected one"""
+
+    bl_idname = "twist.edit_bone_map"
+    bl_label = "Edit Bone Map"
+    bl_options = {"REGISTER", "UNDO"}
+
+    action: bpy.props.EnumProperty(
+        name="Action", items=[("ADD", "Add", "Add an empty pair after the selected one"),
+                              ("REMOVE", "Remove", "Remove the selected pair")])
+
+    def execute(self, context):
+        tw = context.scene.twist
+        if self.action == "ADD":
+            tw.bone_map.add()
+            tw.bone_map.move(len(tw.bone_map) - 1, tw.active_bone_pair + 1)
+            tw.active_bone_pair = min(tw.active_bone_pair + 1, len(tw.bone_map) - 1)
+        elif len(tw.bone_map):
+            tw.bone_map.remove(tw.active_bone_pair)
+            tw.active_bone_pair = max(0, min(tw.active_bone_pair, len(tw.bone_map) - 1))
+        return {"FINISHED"}
+
+
+CLASSES = (TWIST_OT_retarget, TWIST_OT_load_bone_map, TWIST_OT_edit_bone_map)
