@@ -39,3 +39,27 @@ def test_no_blobs_no_body(bpy_module, registered):
     bpy.ops.object.mode_set(mode="OBJECT")
     with pytest.raises(RuntimeError, match="no bone of 'Walker' has a blob"):
         bpy.ops.twist.add_volumetric_body()
+
+
+def test_stick_figure_rods_run_from_head_to_tail_of_their_bones(bpy_module, registered):
+    bpy = bpy_module
+    from support.walking import walking_template
+
+    scene, arm = walking_template(bpy, registered, frames=8)
+    scene.frame_set(1)
+    assert bpy.ops.twist.add_volumetric_body(sticks=True) == {"FINISHED"}
+    sticks = [o for o in bpy.data.collections["Twist body"].objects
+              if o.name.startswith("stick ")]
+    sk = registered.twist_addon.bridge.skeleton_from_armature(arm)
+    assert len(sticks) == len(sk.blobs)
+    W = np.array(arm.matrix_world)
+    for f in (1, 6):
+        scene.frame_set(f)
+        for o in sticks:
+            pb = arm.pose.bones[o.parent_bone]
+            M = np.array(o.matrix_world)
+            z = np.array([v.co.z for v in o.data.vertices])
+            for end, point in ((z.min(), pb.head), (z.max(), pb.tail)):  # the rod's caps
+                want = (W @ np.append(np.array(point), 1))[:3]
+                np.testing.assert_allclose((M @ [0, 0, end, 1])[:3], want, atol=1e-5)
+            assert np.linalg.norm(M[:3, 0]) < 0.5 * np.linalg.norm(M[:3, 2])  # thin
