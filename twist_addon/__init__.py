@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import body, cycle, export, fit, operators, overlay, panels, properties, retarget
+from . import body, cycle, export, fit, operators, overlay, panels, properties, retarget, smooth
 
-MODULES = (properties, operators, fit, body, cycle, retarget, export, panels, overlay)
+MODULES = (properties, operators, fit, body, smooth, cycle, retarget, export, panels, overlay)
 
 
 def register():

@@ -1,5 +1,6 @@
 """The sidebar tab in the 3D viewport, in the order of the work: footage and views, armature,
-track (settings folded away), results."""
+track (settings folded away), results, and what to make of them (animation, with the
+retargeting bone map folded away)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,16 @@ class TWIST_UL_views(bpy.types.UIList):
         row = layout.row(align=True)
         row.prop(item, "camera", text="", icon="CAMERA_DATA")
         row.prop(item, "images", text="")
+
+
+class TWIST_UL_bone_map(bpy.types.UIList):
+    """One row per bone pair: tracked bone, then the target bone that copies it."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname):
+        row = layout.row(align=True)
+        row.prop(item, "source", text="", emboss=False, icon="BONE_DATA")
+        row.label(icon="FORWARD")
+        row.prop(item, "target", text="", emboss=False)
 
 
 class _TwistPanel:
@@ -69,12 +80,6 @@ class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
         row.scale_y = 1.4
         row.operator("twist.track", icon="TRACKING")
         layout.operator("twist.clear_track", icon="X")
-        layout.operator("twist.make_cycle", icon="FILE_REFRESH")
-        layout.operator("twist.add_volumetric_body", icon="MESH_UVSPHERE")
-        layout.operator("twist.retarget", icon="ARMATURE_DATA")
-        row = layout.row(align=True)
-        row.operator("twist.export_bvh", text="BVH", icon="EXPORT")
-        row.operator("twist.export_fbx", text="FBX", icon="EXPORT")
 
 
 class TWIST_PT_track_settings(_TwistPanel, bpy.types.Panel):
@@ -106,5 +111,38 @@ class TWIST_PT_results(_TwistPanel, bpy.types.Panel):
             layout.label(text="Stopped at frame " + result.diverged_frames, icon="ERROR")
 
 
-CLASSES = (TWIST_UL_views, TWIST_PT_views, TWIST_PT_armature, TWIST_PT_track,
-           TWIST_PT_track_settings, TWIST_PT_results)
+class TWIST_PT_animation(_TwistPanel, bpy.types.Panel):
+    bl_label = "Animation"
+
+    def draw(self, context):
+        layout = self.layout
+        col = layout.column(align=True)
+        col.operator("twist.smooth_track", icon="SMOOTHCURVE")
+        col.operator("twist.make_cycle", icon="FILE_REFRESH")
+        layout.operator("twist.add_volumetric_body", icon="MESH_UVSPHERE")
+        layout.operator("twist.retarget", icon="ARMATURE_DATA")
+        row = layout.row(align=True)
+        row.operator("twist.export_bvh", text="BVH", icon="EXPORT")
+        row.operator("twist.export_fbx", text="FBX", icon="EXPORT")
+
+
+class TWIST_PT_bone_map(_TwistPanel, bpy.types.Panel):
+    bl_label = "Bone Map"
+    bl_parent_id = "TWIST_PT_animation"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        tw = context.scene.twist
+        layout = self.layout
+        row = layout.row()
+        row.template_list("TWIST_UL_bone_map", "", tw, "bone_map", tw, "active_bone_pair",
+                          rows=4)
+        col = row.column(align=True)
+        col.operator("twist.edit_bone_map", icon="ADD", text="").action = "ADD"
+        col.operator("twist.edit_bone_map", icon="REMOVE", text="").action = "REMOVE"
+        layout.operator("twist.load_bone_map", icon="PRESET")
+
+
+CLASSES = (TWIST_UL_views, TWIST_UL_bone_map, TWIST_PT_views, TWIST_PT_armature,
+           TWIST_PT_track, TWIST_PT_track_settings, TWIST_PT_results, TWIST_PT_animation,
+           TWIST_PT_bone_map)

@@ -16,7 +16,11 @@ class Recorder:
     def __getattr__(self, name):
         if name in ("row", "column", "box", "split", "grid_flow", "column_flow"):
             return lambda *a, **k: Recorder(self.calls)
-        return lambda *a, **k: self.calls.append((name, a, k))
+        def record(*a, **k):
+            self.calls.append((name, a, k))
+            return types.SimpleNamespace()  # what operator() gives: properties to set
+
+        return record
 
     def __setattr__(self, name, value):
         if name == "calls":
@@ -54,12 +58,13 @@ def test_panels_draw_existing_properties_and_operators(bpy_module, registered, t
                 assert rna.description, op
                 drawn_ops.add(op)
             elif name == "template_list":
-                assert args[0] == "TWIST_UL_views"
+                assert args[0] in ("TWIST_UL_views", "TWIST_UL_bone_map")
                 assert args[3] in args[2].bl_rna.properties
     assert {"armature", "mode", "direction", "levels", "stop_on_divergence",
             "frames_tracked", "first_frame"} <= drawn_props
     assert {"twist.track", "twist.clear_track", "twist.add_view", "twist.remove_view",
-            "twist.add_template_armature"} <= drawn_ops
+            "twist.add_template_armature", "twist.smooth_track", "twist.make_cycle",
+            "twist.retarget", "twist.load_bone_map", "twist.edit_bone_map"} <= drawn_ops
 
 
 def test_add_and_remove_views(bpy_module, registered, tmp_path):
