@@ -157,7 +157,7 @@ def make_cycle(arm, first: int, last: int, period: float | None = None,
                                       BodyMirror(arm, curves, values, period / 2))
         _continuous_quaternions(cycle, curves)
     else:
-        if n + 3 > len(frames):
+        if n > len(frames):
             raise BridgeError(f"a cycle of {n} frames does not fit in frames {first}-{last}: "
                               f"complete it by mirroring")
         start = last - n + 1
@@ -203,6 +203,10 @@ class TWIST_OT_make_cycle(ArmatureAction, bpy.types.Operator):
     period: bpy.props.FloatProperty(
         name="Period", default=0.0, min=0.0,
         description="Frames per cycle; 0 finds it from the tracked legs")
+    range_is_cycle: bpy.props.BoolProperty(
+        name="Frame Range Is One Cycle", default=False,
+        description="The scene's frame range spans exactly one cycle: its length is the "
+                    "period")
     blend: bpy.props.IntProperty(
         name="Blend", default=4, min=1,
         description="Frames at the end of the cycle bent into its start")
@@ -221,8 +225,10 @@ class TWIST_OT_make_cycle(ArmatureAction, bpy.types.Operator):
 
     def run(self, context) -> str:
         scene = context.scene
+        period = (scene.frame_end - scene.frame_start + 1 if self.range_is_cycle
+                  else self.period or None)
         start, n = make_cycle(scene.twist.armature, scene.frame_start, scene.frame_end,
-                              self.period or None, self.blend, self.in_place, self.mirror)
+                              period, self.blend, self.in_place, self.mirror)
         return f"a cycle of {n} frames from frame {start}, repeating"
 
 

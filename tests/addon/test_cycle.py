@@ -115,3 +115,13 @@ def test_mirroring_needs_paired_bones_and_half_a_cycle(bpy_module, registered):
     arm.data.bones["RightKnee"].name = "Knee2"
     with pytest.raises(RuntimeError, match="'LeftKnee' has no tracked partner 'RightKnee'"):
         bpy.ops.twist.make_cycle(mirror=True, period=PERIOD)
+
+
+def test_the_frame_range_can_be_the_cycle(bpy_module, registered):
+    bpy = bpy_module
+    scene, arm = walking_template(bpy, registered)
+    scene.frame_start, scene.frame_end = 5, 28
+    assert bpy.ops.twist.make_cycle(range_is_cycle=True) == {"FINISHED"}
+    bag = registered.twist_addon.keyframes.channelbag(arm)
+    keys = [kp.co[0] for kp in bag.fcurves[0].keyframe_points]
+    assert keys == list(range(5, 30))  # 24 frames and the key that closes the cycle
