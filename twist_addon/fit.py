@@ -1,6 +1,7 @@
 """Fit the armature's pose on the current frame to joint markers placed in each view: the
-paper's initialisation from clicked joints (section 2.6). Bone lengths stay as they are here
-(``python -m core fit`` fits them too).
+paper's initialisation from clicked joints (section 2.6); on request its bone lengths too,
+written into the rest pose (each bone's head moved along its offset from its parent's head,
+so bone directions, rolls and therefore keyed rotations stay as they were).
 
 Markers are kept per view as (bone, x, y) in the view's image pixels (x right, y down, origin
 at the top-left pixel's centre); a bone's marker is the position of its head.
@@ -55,9 +56,36 @@ def read_markers_csv(path: Path, scene) -> int:
     return count
 
 
-def fit_armature(scene) -> float:
-    """Pose the scene's armature to its views' markers (its bone lengths kept); returns the
-    RMS pixel error."""
+def scale_bones(arm, factors: dict[str, float]) -> None:
+    """Move each bone's head away from its parent's head by ``factors[bone]`` (1 if absent)
+    times their rest distance; a tail on a child's head follows that head, any other tail
+    keeps its bone's length (as the core skeleton keeps its end sites)."""
+    view_layer = bpy.context.view_layer
+    active, view_layer.objects.active = view_layer.objects.active, arm
+    bpy.ops.object.mode_set(mode="EDIT")
+    bones = arm.data.edit_bones
+    old = {b.name: (np.array(b.head), np.array(b.tail)) for b in bones}
+    head = {}
+    for b in bones:  # parents come before their children
+        if b.parent is None:
+            head[b.name] = old[b.name][0]
+        else:
+            p = b.parent.name
+            head[b.name] = head[p] + factors.get(b.name, 1.0) * (old[b.name][0] - old[p][0])
+    for b in bones:
+        h, t = old[b.name]
+        on_child = [c.name for c in b.children if np.allclose(old[c.name][0], t, atol=1e-6)]
+        tail = head[on_child[0]] if on_child else head[b.name] + (t - h)
+        roll = b.roll
+        b.head, b.tail, b.roll = head[b.name].tolist(), tail.tolist(), roll
+    bpy.ops.object.mode_set(mode="OBJECT")
+    view_layer.objects.active = active
+
+
+def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, float]]:
+    """Pose the scene's armature to its views' markers, and with ``fit_lengths`` scale its
+    bones to them too; returns the RMS pixel error and the length factor of every bone
+    whose length changed."""
     tw = scene.twist
     arm = tw.armature
     if arm is None:
@@ -75,9 +103,13 @@ def fit_armature(scene) -> float:
     R, root = pose_from_armature(arm, sk)
     mode = tw.mode.lower()
     try:
-        res = fit_pose(sk, BodyPose(R, root, views), clicks, mode, fit_lengths=False)
+        res = fit_pose(sk, BodyPose(R, root, views), clicks, mode, fit_lengths=fit_lengths)
     except FitError as e:
         raise BridgeError(str(e)) from None
+    changed = {n: f for n, f in res.lengths.items() if abs(f - 1) > 1e-4}
+    if changed:
+        scale_bones(arm, changed)
+        sk = skeleton_from_armature(arm)
     R_fit = res.pose.rotations.copy()
     R_fit[0], root_fit = world_root(mode, views[0], res.pose)
     Q, loc = armature_rotations(arm, sk, R_fit, root_fit)
@@ -88,7 +120,7 @@ def fit_armature(scene) -> float:
         elif pb.rotation_mode != "AXIS_ANGLE":
             pb.rotation_euler = Matrix(Q[j].tolist()).to_euler(pb.rotation_mode)
     arm.pose.bones[sk.names[0]].location = loc
-    return res.residual_px
+    return res.residual_px, changed
 
 
 class TWIST_OT_import_markers(ArmatureAction, bpy.types.Operator):
@@ -115,10 +147,18 @@ class TWIST_OT_fit_pose(ArmatureAction, bpy.types.Operator):
     bl_idname = "twist.fit_pose"
     bl_label = "Fit Pose to Markers"
 
+    fit_lengths: bpy.props.BoolProperty(
+        name="Fit Bone Lengths", default=False,
+        description="Also scale the bones to the markers (left and right alike) and write "
+                    "the lengths into the armature's rest pose")
+
     def run(self, context) -> str:
-        rms = fit_armature(context.scene)
+        rms, changed = fit_armature(context.scene, self.fit_lengths)
         context.view_layer.update()
-        return f"fitted: joints {rms:.1f} px from their markers (RMS)"
+        lengths = (", ".join(f"{n} x{f:.3f}" for n, f in sorted(changed.items()))
+                   if changed else "")
+        return (f"fitted: joints {rms:.1f} px from their markers (RMS)"
+                + (f"; lengths {lengths}" if lengths else ""))
 
 
 CLASSES = (TWIST_OT_import_markers, TWIST_OT_fit_pose)

@@ -66,6 +66,8 @@ class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("twist.import_markers", icon="IMPORT")
         row.operator("twist.fit_pose", icon="CON_KINEMATIC")
+        layout.operator("twist.fit_pose", text="Fit Pose and Bone Lengths",
+                        icon="CON_KINEMATIC").fit_lengths = True
         layout.operator_menu_enum("twist.add_template_armature", "template", icon="ARMATURE_DATA")
 
 

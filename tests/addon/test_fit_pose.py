@@ -72,3 +72,52 @@ def test_bad_markers_are_refused(bpy_module, registered, tmp_path):
     bpy.ops.twist.import_markers(filepath=str(tmp_path / "few.csv"))
     with pytest.raises(RuntimeError, match="click at least"):
         bpy.ops.twist.fit_pose()
+
+
+def test_fitting_bone_lengths_writes_them_into_the_rest_pose(bpy_module, registered):
+    """Markers projected from the template with longer thighs and shorter upper arms (left and
+    right alike), 1 px of noise: the fit scales the limbs to within 2 % (the 10 cm trunk
+    bones, 25 px long, within 6 %), keeps every bone's rest direction and roll, and its joints
+    land within a centimetre."""
+    bpy = bpy_module
+    from mathutils import Quaternion
+
+    scene, arm = _scene_with_views(bpy, registered)
+    tw = registered.twist_addon
+    truth_factors = {"LeftKnee": 1.08, "RightKnee": 1.08, "LeftElbow": 0.92,
+                     "RightElbow": 0.92}
+    rest_before = {b.name: np.array(b.matrix_local)[:3, :3] for b in arm.data.bones}
+    lengths_before = {b.name: b.length for b in arm.data.bones}
+    tw.fit.scale_bones(arm, truth_factors)
+    true_lengths = {b.name: b.length for b in arm.data.bones}
+    assert true_lengths["LeftHip"] == pytest.approx(1.08 * lengths_before["LeftHip"])
+    sk = tw.bridge.skeleton_from_armature(arm)
+    rng = np.random.default_rng(1)
+    for name, kind in zip(sk.names, sk.kinds):
+        pb = arm.pose.bones[name]
+        if kind == "ball":
+            pb.rotation_quaternion = Quaternion(rng.normal(0, 0.3, 3), 0.4)
+        elif kind == "hinge":
+            pb.rotation_euler[2] = rng.uniform(0.2, 0.9)
+    bpy.context.view_layer.update()
+    truth = sk.world_positions(*tw.bridge.pose_from_armature(arm, sk))
+    for v in scene.twist.views:
+        view = tw.bridge.view_from_camera(v.camera, scene)
+        for j, name in enumerate(sk.names):
+            m = v.markers.add()
+            m.bone = name
+            m.x, m.y = view.project(truth[j]) + rng.normal(0, 1.0, 2)
+    tw.fit.scale_bones(arm, {n: 1 / f for n, f in truth_factors.items()})  # the guess
+    for pb in arm.pose.bones:
+        pb.rotation_quaternion, pb.rotation_euler = (1, 0, 0, 0), (0, 0, 0)
+    assert bpy.ops.twist.fit_pose(fit_lengths=True) == {"FINISHED"}
+    bpy.context.view_layer.update()
+    for b in arm.data.bones:
+        limb = b.name.endswith(("Hip", "Knee", "Shoulder", "Elbow"))
+        assert b.length == pytest.approx(true_lengths[b.name], rel=0.02 if limb else 0.06), (
+            b.name)
+        np.testing.assert_allclose(np.array(b.matrix_local)[:3, :3], rest_before[b.name],
+                                   atol=1e-5)
+    sk = tw.bridge.skeleton_from_armature(arm)
+    got = sk.world_positions(*tw.bridge.pose_from_armature(arm, sk))
+    assert np.abs(got - truth).max() < 0.01
