@@ -50,6 +50,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
         "frames_tracked": len(result.frames),
         "cancelled": result.cancelled,
         "diverged_frames": result.diverged_frames,
+        "notes": result.notes,
         "seconds": seconds,
         "frames_per_second": len(tracked) / seconds if seconds > 0 else None,
         "seconds_per_iteration": sum(f.seconds for f in tracked) / iters if iters else None,

@@ -10,8 +10,11 @@ robust cost on the pixels visible before and after it, and shortened so that no 
 more than a few degrees at once. A joint is solved only on levels where its blob is thick
 enough to see. Pixels whose front-most blob in the new frame is not the blob they came from
 are left out (a leg passing behind the other); pixel weights are the blob's rim weight times
-the EM support posterior. A frame whose residual jumps, whose body leaves the images or whose
-system is degenerate is reported as diverged instead of being accepted.
+the EM support posterior. With still cameras, the blobs' outline is also held against the
+body's silhouette (``silhouette``): chamfer pulls in both directions whose reach is a limb's
+length, not a blob's width, so that a fast limb is caught and a lost one found again. A frame
+whose residual jumps, whose body leaves the images or whose system is degenerate is reported
+as diverged instead of being accepted.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ import numpy as np
 
 from . import image as imagelib
 from . import raycast
+from . import silhouette as sil
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from .skeleton import Skeleton
@@ -35,6 +39,9 @@ from .solver import (
     solve,
     support_weights,
 )
+
+SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
+BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
 
 
 def _knob(default, doc: str):
@@ -73,6 +80,11 @@ class TrackerSettings:
     min_inside: float = _knob(0.5, "Flag a frame when less of the body than this stays "
                               "inside a view's image")
     stop_on_divergence: bool = _knob(True, "Stop at the first flagged frame")
+    silhouette: float = _knob(0.1, "Weight of the body's silhouette against the still "
+                              "backdrop (0: off): pulls limbs onto the outline from farther "
+                              "than brightness reaches. Needs cameras that stand still")
+    silhouette_cap: float = _knob(24.0, "Farthest a silhouette mismatch pulls, in pixels of "
+                                  "the full image")
 
     def __post_init__(self):
         for name in ("levels", "iterations", "pixel_step"):
@@ -98,6 +110,7 @@ class FrameResult:
 class TrackResult:
     frames: list[FrameResult] = field(default_factory=list)
     cancelled: bool = False
+    notes: list[str] = field(default_factory=list)  # the tracker's notes on the run
 
     @property
     def diverged_frames(self) -> list[int]:
@@ -123,6 +136,8 @@ class _Samples:
     costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
     parts: list  # per set: (indices of usable points, their q, image gradients, residuals)
     inside: np.ndarray  # (views,) fraction of each view's points inside its image
+    shape_cost: float = 0.0  # the silhouette term's cost
+    shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
 
 
 class ImageSequence:
@@ -133,6 +148,7 @@ class ImageSequence:
         self.levels = levels
         self.highpass = highpass
         self._cache: dict[tuple[int, int], list[imagelib.Level]] = {}
+        self._grey: dict[tuple[int, int], np.ndarray] = {}
 
     @property
     def n_views(self) -> int:
@@ -144,15 +160,24 @@ class ImageSequence:
     def pyramid(self, view: int, frame: int) -> list[imagelib.Level]:
         key = (view, frame)
         if key not in self._cache:
-            src = self.images[view][frame]
-            img = imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
-            self._cache[key] = imagelib.pyramid(img, self.levels, highpass=self.highpass)
+            self._cache[key] = imagelib.pyramid(self.grey(view, frame), self.levels,
+                                                highpass=self.highpass)
         return self._cache[key]
 
+    def grey(self, view: int, frame: int) -> np.ndarray:
+        """The full-resolution grey image, unfiltered."""
+        key = (view, frame)
+        if key not in self._grey:
+            src = self.images[view][frame]
+            self._grey[key] = (imagelib.to_grey(src) if isinstance(src, np.ndarray)
+                               else imagelib.load_grey(src))
+        return self._grey[key]
+
     def keep_only(self, keys: set[tuple[int, int]]) -> None:
-        for k in list(self._cache):
-            if k not in keys:
-                del self._cache[k]
+        for cache in (self._cache, self._grey):
+            for k in list(cache):
+                if k not in keys:
+                    del cache[k]
 
 
 class Tracker:
@@ -183,7 +208,64 @@ class Tracker:
         self.dof_thickness = thin[skeleton.dof_joints_and_axes()[0]]
         self._blob_joints = np.array([b.joint for b in skeleton.blobs], dtype=int)
         self._blob_centres = np.array([b.centre for b in skeleton.blobs])
+        self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
+        self.notes: list[str] = []  # what the user should know about the run
+        self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
 
+    def _foregrounds(self, frame: int, lv: int, key: BodyPose, key_frame: int,
+                     est: BodyPose, kin: Kinematics) -> list | None:
+        """Per view, the foreground of ``frame`` on level ``lv`` around the body at ``est``
+        (None when the term is off): (boolean crop, its top-left level pixel). Backdrops are
+        learned from the key frame the first time they are needed."""
+        s = self.settings
+        if s.silhouette <= 0:
+            return None
+        if self._backdrops is None:
+            kin_key = Kinematics(self.skeleton, key)
+            self._backdrops = []
+            others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
+            for c in range(self.seq.n_views):
+                grey = self.seq.grey(c, key_frame)
+                backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
+                    self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})])
+                if not backdrop.still:
+                    self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
+                                      "frame (a moving camera?), so its silhouette is not used")
+                self._backdrops.append(backdrop if backdrop.still else None)
+        out = []
+        margin = s.silhouette_cap / 2**lv + 2
+        for c in range(self.seq.n_views):
+            if self._backdrops[c] is None:
+                out.append(None)
+                continue
+            if (c, frame) not in self._fg_cache:
+                self._fg_cache = {k: v for k, v in self._fg_cache.items() if k[1] == frame}
+                self._fg_cache[c, frame] = self._backdrops[c].foreground(
+                    self.seq.grey(c, frame))
+            shape = self.seq.pyramid(c, frame)[lv].shape
+            boxes = raycast.blob_boxes(est.views[c].at_level(lv), self.skeleton.blobs,
+                                       kin.segments)
+            x0, y0 = np.maximum(np.floor(boxes[:, :2].min(0) - margin), 0).astype(int)
+            x1 = int(min(np.ceil(boxes[:, 2].max() + margin), shape[1]))
+            y1 = int(min(np.ceil(boxes[:, 3].max() + margin), shape[0]))
+            fg = sil.at_level(self._fg_cache[c, frame], lv)
+            out.append((fg[y0:max(y1, y0), x0:max(x1, x0)], (x0, y0)))
+        return out
+
+    def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
+        """Full-resolution pixels the blobs cover at ``pose`` in ``view``."""
+        return self._label_map(pose, kin, view, shape, 0)[0] >= 0
+
+    def _learn_backdrops(self, res: FrameResult) -> None:
+        """Let each view's backdrop see behind where the body was on an earlier frame, now
+        that the tracked pose says where it is not."""
+        if not self._backdrops:
+            return
+        kin = Kinematics(self.skeleton, res.pose)
+        for c, backdrop in enumerate(self._backdrops):
+            if backdrop is not None and backdrop.unseen.any():
+                grey = self.seq.grey(c, res.frame)
+                backdrop.learn(grey, self._body_mask(res.pose, kin, c, grey.shape))
 
     def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
         """Unknowns solved on level ``lv``: the root always; a joint only where its blob is at
@@ -214,23 +296,44 @@ class Tracker:
         return _PointSet(view, seg_joint, label, ref, value, rim * set_weight)
 
     def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int):
+        """Front-most blob per level pixel (-1: none), and per pixel the index of its hit."""
         v_l = pose.views[view].at_level(lv)
         pix, hits, box = raycast.render_labels(v_l, self.skeleton.blobs, kin.segments, shape)
-        lab = np.full(shape, -1, dtype=int)
+        lab = np.full(shape, -1, dtype=np.int32)
+        idx = np.full(shape, -1, dtype=np.int32)
         if box is not None:
             lab[pix[:, 1].astype(int), pix[:, 0].astype(int)] = hits.label
-        return lab
+            idx[pix[:, 1].astype(int), pix[:, 0].astype(int)] = np.arange(len(pix))
+        return lab, idx, hits
 
     # --- one level -----------------------------------------------------------------------
     def _sample(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
-                lv: int, sigmas: list[float]) -> _Samples:
+                lv: int, sigmas: list[float], fgs: list | None = None) -> _Samples:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
         where the point is hidden by another blob or off the image) and what the rows need."""
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
-        labels = [self._label_map(est, kin, c, levels[c].shape, lv)
-                  for c in range(self.seq.n_views)]
+        maps = [self._label_map(est, kin, c, levels[c].shape, lv)
+                for c in range(self.seq.n_views)]
+        labels = [m[0] for m in maps]
+        shape_cost, shape_parts = 0.0, []
+        if fgs is not None:
+            cap = s.silhouette_cap / 2**lv
+            density = 1.0 / (s.pixel_step**2 if lv == 0 else 1)
+            for (lab, idx, hits), view_fg in zip(maps, fgs):
+                if view_fg is None:
+                    shape_parts.append(((), (), (), ()))
+                    continue
+                fg, (x0, y0) = view_fg
+                crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
+                mm = sil.mismatch(lab[crop], fg, cap)
+                shape_cost += s.silhouette * density * mm.cost
+                mm.model += (x0, y0)
+                mm.target += (x0, y0)
+                h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
+                shape_parts.append((self._blob_joints[hits.label[h]], hits.world[h],
+                                    mm.target * 2**lv, mm.weight))
         for ps, sigma in zip(sets, sigmas):
             view = est.views[ps.view]
             q = view.scaled(kin.world_points(ps.seg_joint, ps.ref))
@@ -250,16 +353,34 @@ class Tracker:
             c[ok] = ps.weight[ok] * mixture_cost(r, sigma, s.outlier_density)
             costs.append(c)
             parts.append((ok, q[ok], vals[ok, 1:3], r))
-        return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1))
+        return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
+                        shape_cost, shape_parts)
 
     def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
-                          sigmas: list[float]) -> NormalEquations:
-        """Rows of every point set at the sampled pose, weighted by the EM support posterior."""
+                          sigmas: list[float], lv: int = 0) -> NormalEquations:
+        """Rows of every point set at the sampled pose, weighted by the EM support posterior,
+        and the silhouette's rows (each mismatched pixel's two coordinates)."""
         ne = NormalEquations.zeros(self.n_params)
         for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
             if len(ok):
                 w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
                 ne.add(rows(kin, ps.view, self.mode, ps.seg_joint[ok], q, grad), r, w)
+        s = self.settings
+        density = 1.0 / (s.pixel_step**2 if lv == 0 else 1)
+        for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
+            if not len(joints):
+                continue
+            every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
+            joints, world, target = joints[::every], world[::every], target[::every]
+            pair_w = pair_w[::every]
+            view = kin.pose.views[c]
+            q = view.scaled(world)
+            n = len(q)
+            unit = np.zeros((2 * n, 2))  # x rows, then y rows
+            unit[:n, 0] = unit[n:, 1] = 1.0
+            r = (q[:, :2] + view.center - target).T.ravel()
+            w = np.tile(pair_w, 2) * (s.silhouette * density * every / 4**lv)
+            ne.add(rows(kin, c, self.mode, np.tile(joints, 2), np.tile(q, (2, 1)), unit), r, w)
         return ne
 
     def _sigmas(self, est: BodyPose, kin: Kinematics, sets, levels) -> list[float]:
@@ -326,14 +447,17 @@ class Tracker:
                                                             s.key_weight)
                     sets.append(self._key_sets[k])
             kin = Kinematics(self.skeleton, est)
-            sigmas = self._sigmas(est, kin, sets, levels)
             active = self._active(est, lv)
-            smp = self._sample(est, kin, sets, levels, lv, sigmas)
+            # a silhouette where some limb cannot move yet would pull the rest in its place
+            fgs = (self._foregrounds(frame, lv, key, key_frame, est, kin) if active.all()
+                   else None)
+            sigmas = self._sigmas(est, kin, sets, levels)
+            smp = self._sample(est, kin, sets, levels, lv, sigmas, fgs)
             left = self._left_views(smp)
             if left:
                 return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
                                    time.perf_counter() - t0)
-            ne = self._normal_equations(kin, sets, smp, sigmas)
+            ne = self._normal_equations(kin, sets, smp, sigmas, lv)
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
             converged = False
@@ -342,11 +466,12 @@ class Tracker:
                 delta = self._trust(solve(ne, lam, prior, offset, active))
                 cand = apply_update(self.skeleton, est, delta, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
-                c_smp = self._sample(cand, kin_c, sets, levels, lv, sigmas)
+                c_smp = self._sample(cand, kin_c, sets, levels, lv, sigmas, fgs)
                 # compare on the pixels seen in both poses: a step must not win by hiding pixels
                 both = ~np.isnan(smp.costs) & ~np.isnan(c_smp.costs)
-                old = float(np.sum(smp.costs[both]) + prior @ offset**2)
-                new = float(np.sum(c_smp.costs[both]) + prior @ (offset + delta) ** 2)
+                old = float(np.sum(smp.costs[both]) + smp.shape_cost + prior @ offset**2)
+                new = float(np.sum(c_smp.costs[both]) + c_smp.shape_cost
+                            + prior @ (offset + delta) ** 2)
                 if new <= old:
                     moved = np.max(np.linalg.norm(self._blob_pixels(kin_c)
                                                   - self._blob_pixels(kin), axis=-1))
@@ -356,7 +481,7 @@ class Tracker:
                     if moved / 2**lv < s.converge_pixels:
                         converged = True
                         break
-                    ne = self._normal_equations(kin, sets, smp, sigmas)
+                    ne = self._normal_equations(kin, sets, smp, sigmas, lv)
                 else:
                     lam *= 4
                     if lam > 1e4:
@@ -389,6 +514,7 @@ class Tracker:
             )
         key_frame, key = frames[0], initial
         self._key_sets.clear()  # the key pose may differ from an earlier run's
+        self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
         yield first
         history = [first]
@@ -423,6 +549,8 @@ class Tracker:
                         f" the median so far ({np.median(residuals):.4f})"
                     )
             residuals.append(res.residual)
+            if not res.diverged:
+                self._learn_backdrops(res)
             self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
                                 for f in (key_frame, prev.frame, frame)})
             yield res
@@ -450,4 +578,5 @@ def track(
         if cancel and cancel():
             out.cancelled = len(out.frames) < total
             break
+    out.notes = list(tracker.notes)
     return out

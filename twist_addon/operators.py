@@ -26,12 +26,15 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
     msg = f"tracked {len(done)} of {len(session.frames) - 1} frames"
     if cancelled:
         msg += " (cancelled; the tracked frames are kept)"
+    notes = session.tracker.notes
+    if notes:
+        msg += "; " + "; ".join(notes)
     if diverged:
         last = session.tracked[-1]
         msg += f"; stopped at frame {diverged[0]}: {last.reason}. Correct the pose there " \
                "and track again from it"
         return {"WARNING"}, msg
-    return {"INFO"}, msg
+    return ({"WARNING"} if notes else {"INFO"}), msg
 
 
 class TWIST_OT_track(ArmatureAction, bpy.types.Operator):

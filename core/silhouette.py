@@ -1,0 +1,132 @@
+"""The body's silhouette against a still backdrop: a cue whose basin is as wide as a limb is
+long, where brightness constancy only reaches a blob's width.
+
+Each view's backdrop is the key frame with the body taken out (see ``Backdrop``); a pixel
+is foreground where it differs from the backdrop by more than a threshold set from the
+image's own noise (the cameras must stand still). Two chamfer terms compare the
+blobs' projection (a label map) with the foreground, each in both directions:
+foreground pixels no blob covers pull the nearest covered pixel toward them, and covered
+pixels off the foreground are pulled to the nearest foreground pixel. Distances are in
+level pixels, capped so that clutter far from the body cannot pull.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called foreground
+UNCOVERED_WEIGHT = 0.3  # of foreground no blob covers: parts the blobs lack (hands, feet)
+SLACK = 1.0  # level pixels of mismatch forgiven
+STILL_AREA_RATIO = 4.0  # a backdrop holds while frames' foreground stays under this x body
+
+
+class Backdrop:
+    """One view's still backdrop and the foreground of any frame against it.
+
+    It starts as the key frame with the body (its blobs' pixels, widened by a margin for the
+    blobs' own error) painted out from around it; as frames are tracked, ``learn`` puts in
+    what a tracked frame shows where the body has moved off. (A temporal median of the
+    footage would keep in the backdrop a body that stays in one place, walking toward an
+    end-on camera.) ``still`` says whether the backdrop holds: False when ``frames`` of the
+    footage differ from it over far more than the body's area (a moving camera, changing
+    light)."""
+
+    def __init__(self, grey: np.ndarray, body: np.ndarray, frames: Sequence[np.ndarray] = (),
+                 margin: int = 6):
+        grey = np.asarray(grey, np.float32)
+        self.margin = margin
+        self.unseen = self._widen(body)  # pixels whose backdrop is only painted in
+        img8 = np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8)
+        self.image = cv2.inpaint(img8, self.unseen.astype(np.uint8), margin,
+                                 cv2.INPAINT_TELEA).astype(np.float32) / 255
+        noise = np.abs(grey - cv2.medianBlur(grey, 3))[~self.unseen]
+        self.threshold = max(MIN_CONTRAST, 6 * 1.4826 * float(np.median(noise)))
+        area = [self.foreground(np.asarray(f, np.float32)).sum() for f in frames]
+        self.still = not area or float(np.median(area)) <= STILL_AREA_RATIO * max(
+            int(body.sum()), 1)
+
+    def _widen(self, body: np.ndarray) -> np.ndarray:
+        k = np.ones((2 * self.margin + 1,) * 2, np.uint8)
+        return cv2.dilate(body.astype(np.uint8), k) > 0
+
+    def learn(self, grey: np.ndarray, body: np.ndarray) -> None:
+        """Take the backdrop from a tracked frame wherever it is still unseen and that frame's
+        body (its blobs' pixels) is not."""
+        if grey.shape != self.image.shape:
+            return
+        seen = self.unseen & ~self._widen(body)
+        self.image[seen] = grey[seen]
+        self.unseen &= ~seen
+
+    def foreground(self, grey: np.ndarray) -> np.ndarray:
+        """Foreground of a full-resolution grey frame, as 0/1 floats (H, W): pixels off the
+        backdrop, specks removed. Holes are kept: the gap between an arm and the trunk is
+        one. A frame a few pixels larger or smaller than the backdrop is compared where they
+        overlap (top-left corners together); the rest is backdrop."""
+        h, w = (min(a, b) for a, b in zip(grey.shape, self.image.shape))
+        fg = np.zeros(grey.shape, np.float32)
+        fg[:h, :w] = np.abs(grey[:h, :w] - self.image[:h, :w]) > self.threshold
+        return cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+
+
+def at_level(fg: np.ndarray, level: int) -> np.ndarray:
+    """A full-resolution 0/1 foreground as a boolean mask on pyramid level ``level``, made
+    the way the image pyramid is (``cv2.pyrDown``: level pixel i centred on pixel 2i below),
+    so that the mask and the level's label maps line up."""
+    for _ in range(level):
+        fg = cv2.pyrDown(fg)
+    return fg > 0.5
+
+
+@dataclass
+class Mismatch:
+    """Where a label map and a foreground disagree, in level pixels (x, y)."""
+
+    model: np.ndarray  # (N, 2) covered pixels to move
+    target: np.ndarray  # (N, 2) where each should go (its match, less the slack)
+    cost: float  # sum of capped squared distances, weighted
+    weight: np.ndarray  # (N,) each pair's weight
+
+
+def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLACK,
+             uncovered_weight: float = UNCOVERED_WEIGHT) -> Mismatch:
+    """Both chamfer terms between a label map (H, W; -1 where no blob) and a foreground: a
+    pixel ``d`` from its match costs (min(d, cap) - slack)^2 if positive, and wants to move
+    d - slack toward it (the slack forgives outline noise and the holes a body shows where
+    it happens to match the backdrop). Uncovered foreground weighs ``uncovered_weight``:
+    it also comes from what the blobs do not model, and pulled the shanks toward the feet."""
+    covered = labels >= 0
+    cost = 0.0
+    # uncovered foreground pulls its nearest covered pixel; covered background is pulled to
+    # its nearest foreground pixel
+    model, target, weight = [], [], []
+    for src, near_mask, move_near, w in ((fg & ~covered, covered, True, uncovered_weight),
+                                         (covered & ~fg, fg, False, 1.0)):
+        if not src.any() or not near_mask.any():
+            continue
+        # each pixel's nearest pixel of near_mask, as the rank of that pixel in row-major
+        # order (OpenCV numbers the zero pixels that way)
+        _, nearest = cv2.distanceTransformWithLabels(
+            (~near_mask).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5,
+            labelType=cv2.DIST_LABEL_PIXEL)
+        ny, nx = np.nonzero(near_mask)
+        ys, xs = np.nonzero(src)
+        k = nearest[ys, xs] - 1
+        iy, ix = ny[k], nx[k]
+        dist = np.hypot(iy - ys, ix - xs)
+        cost += w * float(np.sum(np.maximum(np.minimum(dist, cap) - slack, 0) ** 2))
+        keep = (dist <= cap) & (dist > slack)
+        near = np.stack([ix[keep], iy[keep]], 1).astype(float)
+        here = np.stack([xs[keep], ys[keep]], 1).astype(float)
+        m, t = (near, here) if move_near else (here, near)
+        model.append(m)
+        target.append(m + (t - m) * (1 - slack / dist[keep])[:, None])
+        weight.append(np.full(len(m), w))
+    if not model:
+        return Mismatch(np.zeros((0, 2)), np.zeros((0, 2)), cost, np.zeros(0))
+    return Mismatch(np.concatenate(model), np.concatenate(target), cost,
+                    np.concatenate(weight))
