@@ -233,7 +233,8 @@ class Tracker:
                                       "frame (a moving camera?), so its silhouette is not used")
                 self._backdrops.append(backdrop if backdrop.still else None)
         out = []
-        margin = s.silhouette_cap / 2**lv + 2
+        g = self._grid(lv)
+        margin = s.silhouette_cap / 2**lv + 2 * g
         for c in range(self.seq.n_views):
             if self._backdrops[c] is None:
                 out.append(None)
@@ -245,16 +246,22 @@ class Tracker:
             shape = self.seq.pyramid(c, frame)[lv].shape
             boxes = raycast.blob_boxes(est.views[c].at_level(lv), self.skeleton.blobs,
                                        kin.segments)
-            x0, y0 = np.maximum(np.floor(boxes[:, :2].min(0) - margin), 0).astype(int)
-            x1 = int(min(np.ceil(boxes[:, 2].max() + margin), shape[1]))
-            y1 = int(min(np.ceil(boxes[:, 3].max() + margin), shape[0]))
-            fg = sil.at_level(self._fg_cache[c, frame], lv)
+            # on the label map's grid (every g-th level pixel)
+            x0, y0 = np.maximum(np.floor((boxes[:, :2].min(0) - margin) / g), 0).astype(int)
+            x1 = int(min(np.ceil((boxes[:, 2].max() + margin) / g), -(-shape[1] // g)))
+            y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
+            fg = sil.at_level(self._fg_cache[c, frame], lv)[::g, ::g]
             out.append((fg[y0:max(y1, y0), x0:max(x1, x0)], (x0, y0)))
         return out
 
+    def _grid(self, lv: int) -> int:
+        """Level pixels between the label map's samples: the fine level is looked at every
+        ``pixel_step`` pixels, like its point sets."""
+        return self.settings.pixel_step if lv == 0 else 1
+
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``."""
-        return self._label_map(pose, kin, view, shape, 0)[0] >= 0
+        return self._label_map(pose, kin, view, shape, 0, 1)[0] >= 0
 
     def _learn_backdrops(self, res: FrameResult) -> None:
         """Let each view's backdrop see behind where the body was on an earlier frame, now
@@ -295,15 +302,20 @@ class Tracker:
         rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
         return _PointSet(view, seg_joint, label, ref, value, rim * set_weight)
 
-    def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int):
-        """Front-most blob per level pixel (-1: none), and per pixel the index of its hit."""
+    def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int,
+                   grid: int):
+        """Front-most blob (-1: none) at every ``grid``-th level pixel, as a map whose pixel
+        (i, j) is level pixel (grid i, grid j), and per map pixel the index of its hit."""
         v_l = pose.views[view].at_level(lv)
-        pix, hits, box = raycast.render_labels(v_l, self.skeleton.blobs, kin.segments, shape)
-        lab = np.full(shape, -1, dtype=np.int32)
-        idx = np.full(shape, -1, dtype=np.int32)
+        pix, hits, box = raycast.render_labels(v_l, self.skeleton.blobs, kin.segments, shape,
+                                               grid)
+        size = (-(-shape[0] // grid), -(-shape[1] // grid))
+        lab = np.full(size, -1, dtype=np.int32)
+        idx = np.full(size, -1, dtype=np.int32)
         if box is not None:
-            lab[pix[:, 1].astype(int), pix[:, 0].astype(int)] = hits.label
-            idx[pix[:, 1].astype(int), pix[:, 0].astype(int)] = np.arange(len(pix))
+            at = (pix[:, 1].astype(int) // grid, pix[:, 0].astype(int) // grid)
+            lab[at] = hits.label
+            idx[at] = np.arange(len(pix))
         return lab, idx, hits
 
     # --- one level -----------------------------------------------------------------------
@@ -314,13 +326,13 @@ class Tracker:
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
-        maps = [self._label_map(est, kin, c, levels[c].shape, lv)
+        g = self._grid(lv)
+        maps = [self._label_map(est, kin, c, levels[c].shape, lv, g)
                 for c in range(self.seq.n_views)]
         labels = [m[0] for m in maps]
         shape_cost, shape_parts = 0.0, []
         if fgs is not None:
-            cap = s.silhouette_cap / 2**lv
-            density = 1.0 / (s.pixel_step**2 if lv == 0 else 1)
+            cap = s.silhouette_cap / (2**lv * g)  # in map pixels
             for (lab, idx, hits), view_fg in zip(maps, fgs):
                 if view_fg is None:
                     shape_parts.append(((), (), (), ()))
@@ -328,18 +340,18 @@ class Tracker:
                 fg, (x0, y0) = view_fg
                 crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
                 mm = sil.mismatch(lab[crop], fg, cap)
-                shape_cost += s.silhouette * density * mm.cost
+                shape_cost += s.silhouette * mm.cost
                 mm.model += (x0, y0)
                 mm.target += (x0, y0)
                 h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
                 shape_parts.append((self._blob_joints[hits.label[h]], hits.world[h],
-                                    mm.target * 2**lv, mm.weight))
+                                    mm.target * (2**lv * g), mm.weight))
         for ps, sigma in zip(sets, sigmas):
             view = est.views[ps.view]
             q = view.scaled(kin.world_points(ps.seg_joint, ps.ref))
             pix = q[:, :2] + view.center
             vals, inside = imagelib.sample(levels[ps.view], pix)
-            p_l = np.rint(imagelib.to_level(pix, levels[ps.view])).astype(int)
+            p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / g).astype(int)
             lab = labels[ps.view]
             H, W = lab.shape
             inb = (p_l[:, 0] >= 0) & (p_l[:, 0] < W) & (p_l[:, 1] >= 0) & (p_l[:, 1] < H)
@@ -366,7 +378,7 @@ class Tracker:
                 w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
                 ne.add(rows(kin, ps.view, self.mode, ps.seg_joint[ok], q, grad), r, w)
         s = self.settings
-        density = 1.0 / (s.pixel_step**2 if lv == 0 else 1)
+        g = 2**lv * self._grid(lv)  # full-resolution pixels per map pixel
         for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
             if not len(joints):
                 continue
@@ -379,7 +391,7 @@ class Tracker:
             unit = np.zeros((2 * n, 2))  # x rows, then y rows
             unit[:n, 0] = unit[n:, 1] = 1.0
             r = (q[:, :2] + view.center - target).T.ravel()
-            w = np.tile(pair_w, 2) * (s.silhouette * density * every / 4**lv)
+            w = np.tile(pair_w, 2) * (s.silhouette * every / g**2)
             ne.add(rows(kin, c, self.mode, np.tile(joints, 2), np.tile(q, (2, 1)), unit), r, w)
         return ne
 

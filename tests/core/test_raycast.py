@@ -53,7 +53,9 @@ def test_rasterised_labels_equal_per_pixel_casting():
         np.testing.assert_allclose(hits.world, ref.world, atol=1e-9)
         np.testing.assert_allclose(hits.rim, ref.rim, atol=1e-9)
         x0, y0, x1, y1 = box
-        xs, ys = np.meshgrid(np.arange(x0, x1, step), np.arange(y0, y1, step))
+        assert np.all(pix % step == 0)  # the grid is the multiples of step
+        xs, ys = np.meshgrid(np.arange(x0 - x0 % step, x1, step),
+                             np.arange(y0 - y0 % step, y1, step))
         every = raycast.cast(view, np.stack([xs.ravel(), ys.ravel()], 1).astype(float),
                              sk.blobs, g)
         assert (every.label >= 0).sum() == len(pix)  # no covered pixel of the box is missed
