@@ -105,3 +105,18 @@ def test_the_silhouette_pulls_in_a_limb_beyond_the_reach_of_brightness():
     lost = error(TrackerSettings(silhouette=0))
     assert lost > 20
     assert error(TrackerSettings()) < 0.3 * lost
+
+
+def test_the_tracker_leaves_out_and_notes_a_view_whose_backdrop_moves():
+    sk = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
+    view = side_view(yaw_deg=0, height=0.0, center=(110, 180))
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3), [view])
+    body = render(sk, pose, 0)
+    rng = np.random.default_rng(2)
+    wall = cv2.GaussianBlur(rng.uniform(0, 1, (360, 400)).astype(np.float32), (0, 0), 1.5)
+    cover = render(sk, pose, 0, background=0.0) == render(sk, pose, 0, background=1.0)
+    frames = [[np.where(cover, body, wall[:, 8 * k: 8 * k + 320]) for k in range(6)]]
+    res = track(Tracker(sk, frames, INDEPENDENT), pose, range(6))
+    assert res.notes == ["view 1: the backdrop changes from frame to frame (a moving "
+                         "camera?), so its silhouette is not used"]
+    assert len(res.frames) == 6 and not res.diverged_frames
