@@ -2,9 +2,22 @@
 
 import bpy
 
-from . import body, cycle, export, fit, operators, overlay, panels, properties, retarget, smooth
+from . import (
+    body,
+    cycle,
+    export,
+    fit,
+    markers,
+    operators,
+    overlay,
+    panels,
+    properties,
+    retarget,
+    smooth,
+)
 
-MODULES = (properties, operators, fit, body, smooth, cycle, retarget, export, panels, overlay)
+MODULES = (properties, operators, markers, fit, body, smooth, cycle, retarget, export, panels,
+           overlay)
 
 
 def register():

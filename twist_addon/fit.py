@@ -3,8 +3,7 @@ paper's initialisation from clicked joints (section 2.6); on request its bone le
 written into the rest pose (each bone's head moved along its offset from its parent's head,
 so bone directions, rolls and therefore keyed rotations stay as they were).
 
-Markers are kept per view as (bone, x, y) in the view's image pixels (x right, y down, origin
-at the top-left pixel's centre); a bone's marker is the position of its head.
+Markers (see ``markers``) are kept per view and frame; the fit uses the current frame's.
 """
 
 from __future__ import annotations
@@ -26,12 +25,14 @@ from .bridge import (
     skeleton_from_armature,
     view_from_camera,
 )
+from .markers import markers_at, set_marker
 from .reporting import ArmatureAction
 
 
 def read_markers_csv(path: Path, scene) -> int:
-    """Load markers from a CSV of ``view, bone, x, y`` rows (view: 1-based number or camera
-    name; a header row is skipped) into the scene's views; returns how many were read."""
+    """Load markers from a CSV of ``view, bone, x, y[, frame]`` rows (view: 1-based number or
+    camera name; frame: the scene frame, the current one if left out; a header row is
+    skipped) into the scene's views; returns how many were read."""
     tw = scene.twist
     by_name = {v.camera.name: v for v in tw.views if v.camera}
     count = 0
@@ -39,19 +40,20 @@ def read_markers_csv(path: Path, scene) -> int:
         for i, row in enumerate(csv.reader(f), 1):
             if not row or row[0].strip().lower() == "view":
                 continue
-            if len(row) != 4:
-                raise BridgeError(f"{path.name}, row {i}: expected view, bone, x, y")
-            key, bone, x, y = (c.strip() for c in row)
+            if len(row) not in (4, 5):
+                raise BridgeError(f"{path.name}, row {i}: expected view, bone, x, y[, frame]")
+            key, bone, x, y = (c.strip() for c in row[:4])
             view = by_name.get(key) or (tw.views[int(key) - 1] if key.isdigit()
                                         and 0 < int(key) <= len(tw.views) else None)
             if view is None:
                 raise BridgeError(f"{path.name}, row {i}: no view '{key}'")
             try:
                 xy = float(x), float(y)
+                frame = int(row[4]) if len(row) == 5 else scene.frame_current
             except ValueError:
-                raise BridgeError(f"{path.name}, row {i}: x and y must be numbers") from None
-            m = next((m for m in view.markers if m.bone == bone), None) or view.markers.add()
-            m.bone, m.x, m.y = bone, *xy
+                raise BridgeError(f"{path.name}, row {i}: x and y must be numbers, frame a "
+                                  "whole number") from None
+            set_marker(view, bone, frame, *xy)
             count += 1
     return count
 
@@ -94,12 +96,11 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
     views = [view_from_camera(v.camera, scene) for v in tw.views if v.camera]
     if not views:
         raise BridgeError("there are no views with cameras to place markers in")
-    clicks = []
-    for v in tw.views:
-        for m in v.markers:
-            if m.bone not in sk.names:
-                raise BridgeError(f"a marker names bone '{m.bone}', which '{arm.name}' lacks")
-        clicks.append({m.bone: np.array([m.x, m.y]) for m in v.markers})
+    clicks = [markers_at(v, scene.frame_current) for v in tw.views if v.camera]
+    for c in clicks:
+        for bone in c:
+            if bone not in sk.names:
+                raise BridgeError(f"a marker names bone '{bone}', which '{arm.name}' lacks")
     R, root = pose_from_armature(arm, sk)
     mode = tw.mode.lower()
     try:
@@ -124,13 +125,14 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
 
 
 class TWIST_OT_import_markers(ArmatureAction, bpy.types.Operator):
-    """Read joint markers from a CSV file of view, bone, x, y rows (pixels, y down)"""
+    """Read joint markers from a CSV file of view, bone, x, y[, frame] rows (pixels, y down)"""
 
     bl_idname = "twist.import_markers"
     bl_label = "Import Markers"
 
     filepath: bpy.props.StringProperty(name="CSV File", subtype="FILE_PATH",
-                                       description="The markers: view, bone, x, y per row")
+                                       description="The markers: view, bone, x, y[, frame] "
+                                                   "per row")
 
     def invoke(self, context, event):
         context.window_manager.fileselect_add(self)

@@ -1,4 +1,5 @@
-"""The blobs' outlines drawn over the viewport, so the user sees whether the body lines up.
+"""The blobs' outlines drawn over the viewport, so the user sees whether the body lines up,
+and, looking through a view's camera, that view's joint markers of the current frame.
 
 Seen through an orthographic camera, an ellipsoid's outline is the curve on it where the view
 direction is tangent: in the blob's normalised frame (a unit sphere) a great circle across the
@@ -30,6 +31,23 @@ def silhouette_loops(sk: Skeleton, R: np.ndarray, root: np.ndarray, view_dir: np
     return out
 
 
+MARKER_PIXELS = 6.0  # half the size of a marker's cross, in footage pixels
+
+
+def marker_crosses(cam, scene, markers: dict, depth_point) -> np.ndarray:
+    """Line segments (markers * 4, 3): a cross of ``MARKER_PIXELS`` on each marker's pixel,
+    placed among the bones (at the depth of ``depth_point``) along the camera's rays."""
+    from .markers import point_of_pixel
+
+    ends = []
+    for p in markers.values():
+        for d in ((MARKER_PIXELS, 0.0), (0.0, MARKER_PIXELS)):
+            ends += [p - d, p + d]
+    if not ends:
+        return np.zeros((0, 3))
+    return np.array([point_of_pixel(cam, scene, e, depth_point) for e in ends])
+
+
 def _draw():
     import bpy
     import gpu
@@ -59,6 +77,19 @@ def _draw():
     shader.uniform_float("color", (0.2, 1.0, 0.3, 0.9))
     gpu.state.line_width_set(1.5)
     batch.draw(shader)
+    from .markers import markers_at, view_of_camera
+
+    view = view_of_camera(scene, scene.camera)
+    if rv3d.view_perspective == "CAMERA" and view is not None:
+        try:
+            crosses = marker_crosses(scene.camera, scene, markers_at(view, scene.frame_current),
+                                     np.array(tw.armature.matrix_world.translation))
+        except BridgeError:
+            return
+        if len(crosses):
+            batch = batch_for_shader(shader, "LINES", {"pos": crosses.astype(np.float32)})
+            shader.uniform_float("color", (1.0, 0.85, 0.1, 1.0))
+            batch.draw(shader)
 
 
 def register():

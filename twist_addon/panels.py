@@ -63,10 +63,16 @@ class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
         layout = self.layout
         layout.prop(tw, "armature")
         layout.prop(tw, "show_overlay")
-        row = layout.row(align=True)
+        box = layout.box()
+        if tw.armature is not None:
+            box.prop_search(tw, "marker_bone", tw.armature.data, "bones")
+        row = box.row(align=True)
+        row.operator("twist.place_markers", icon="RESTRICT_SELECT_OFF")
+        row.operator("twist.clear_markers", icon="X", text="")
+        row = box.row(align=True)
         row.operator("twist.import_markers", icon="IMPORT")
         row.operator("twist.fit_pose", icon="CON_KINEMATIC")
-        layout.operator("twist.fit_pose", text="Fit Pose and Bone Lengths",
+        box.operator("twist.fit_pose", text="Fit Pose and Bone Lengths",
                         icon="CON_KINEMATIC").fit_lengths = True
         layout.operator_menu_enum("twist.add_template_armature", "template", icon="ARMATURE_DATA")
 

@@ -58,9 +58,11 @@ def first_frame_property():
 
 
 class TWIST_PG_marker(bpy.types.PropertyGroup):
-    """A joint placed on a view's footage: the head of ``bone`` at pixel (x, y)."""
+    """A joint placed on a view's footage: the head of ``bone`` at pixel (x, y) on scene
+    frame ``frame``."""
 
     bone: bpy.props.StringProperty(name="Bone", description="The bone whose head this marks")
+    frame: bpy.props.IntProperty(name="Frame", description="The scene frame it was placed on")
     x: bpy.props.FloatProperty(name="X", description="Pixels from the left")
     y: bpy.props.FloatProperty(name="Y", description="Pixels from the top")
 
@@ -120,6 +122,10 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
     views: bpy.props.CollectionProperty(type=TWIST_PG_view)
     active_view: bpy.props.IntProperty(name="Active View", description="The selected view")
     result: bpy.props.PointerProperty(type=TWIST_PG_result)
+    marker_bone: bpy.props.StringProperty(
+        name="Marker Bone",
+        description="The bone whose head the next click of Place Markers marks; each click "
+                    "moves on to the next bone")
     show_overlay: bpy.props.BoolProperty(
         name="Show Blobs", default=True,
         description="Draw the outline of every blob over the viewport, to line the armature up "
