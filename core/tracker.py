@@ -436,6 +436,25 @@ class Tracker:
         centres = kin.world_points(self._blob_joints, self._blob_centres)
         return np.array([v.project(centres) for v in kin.pose.views])
 
+    def frame_pixels(self, prev: BodyPose, prev_frame: int, est: BodyPose, frame: int
+                     ) -> list[tuple]:
+        """The body's pixels of ``prev_frame`` (at pose ``prev``, full resolution, every
+        ``pixel_step``-th) mapped into ``frame`` under ``est``, those visible there: per view
+        (view, segment joints (N,), scaled camera points q (N, 3), image gradients (N, 2),
+        brightness residuals (N,), EM support weights (N,)). For estimates made outside the
+        tracker's own system (the skeleton's refinement)."""
+        kin_prev, kin = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, est)
+        levels = [self.seq.pyramid(c, frame)[0] for c in range(self.seq.n_views)]
+        sets = [self._point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
+                for c in range(self.seq.n_views)]
+        sigmas = self._sigmas(est, kin, sets, levels)
+        smp = self._sample(est, kin, sets, levels, 0, sigmas)
+        out = []
+        for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
+            w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+            out.append((ps.view, ps.seg_joint[ok], q, grad, r, w))
+        return out
+
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
                     predicted: BodyPose, frame: int) -> FrameResult:
         """One frame: refine ``predicted`` against the previous frame (``prev`` on

@@ -1,0 +1,219 @@
+"""The skeleton learned from the footage (paper section 2.7): joint centres and hinge axes
+refined from a tracked sequence.
+
+For one joint and each pair of consecutive frames, the motion of every segment the joint
+moves is the joint's tracked step plus a free rigid correction (a 6-vector twist, least
+squares over those segments' pixels at the tracked pose of the later frame), so that what the
+current skeleton cannot do shows. Written in the joint's frame before its rotation (the
+parent's axes, at the joint), a hinge's twists over time are one twist scaled by its angular
+velocity: the 6 x T matrix of them has rank 1,
+and its first singular vector, scaled so that its rotation part is a unit vector, is the
+hinge's twist (v, w) = (p x w, w): its axis w and the point p on it nearest the old centre.
+A ball joint turns about varying axes through one centre p, so v(t) = p x w(t) gives p by
+least squares. The refined joints are moved there (its children's offsets compensate, so the
+body at rest is unchanged), and the footage is tracked again, until no joint moves.
+
+Calibrated views (one world frame). Planar mode, for a body seen side-on by one view: the
+twists are kept in the image plane (translation along the image axes, rotation about the view
+direction), and a hinge's axis stays along the view direction.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from . import se3
+from .linearize import Kinematics, rows
+from .pose import CALIBRATED, BodyPose
+from .skeleton import BALL, HINGE, Skeleton
+from .solver import NormalEquations, solve
+from .tracker import Tracker, TrackerSettings, track
+
+
+class RefineError(ValueError):
+    """A refinement that cannot be made; the message says why."""
+
+
+def segment_twists(tracker: Tracker, poses: Sequence[BodyPose], frames: Sequence[int],
+                   joint: int, planar: bool = False) -> np.ndarray:
+    """Per step between consecutive tracked frames, the twist (6,) = (v, w) of the segments
+    ``joint`` moves (its tracked step and the free correction the pixels ask for), in the
+    joint's frame before its rotation; (6, T - 1)."""
+    sk = tracker.skeleton
+    moved = sk.moved_by()[:, joint]
+    parent = sk.parents[joint]
+    basis = np.eye(6)
+    if planar:  # translation along the image axes, rotation about the view direction
+        R = poses[0].views[0].pose.R
+        basis = np.zeros((6, 3))
+        basis[:3, 0], basis[:3, 1], basis[3:, 2] = R[0], R[1], R[2]
+    out = []
+    for t in range(1, len(poses)):
+        kin = Kinematics(sk, poses[t])
+        pixels = tracker.frame_pixels(poses[t - 1], frames[t - 1], poses[t], frames[t])
+        own = np.zeros(sk.n_joints, dtype=bool)
+        own[parent] = True
+        # the tracked step turns the segments about the joint's centre; what the pixels of
+        # the joint's segments ask for beyond it, less what its parent's ask for, is what the
+        # skeleton could not do
+        tracked = se3.log_so3(poses[t].rotations[joint] @ poses[t - 1].rotations[joint].T)
+        out.append(np.concatenate([np.zeros(3), tracked])
+                   + _free_twist(kin, pixels, moved, basis, joint)
+                   - _free_twist(kin, pixels, own, basis, joint))
+    return np.array(out).T
+
+
+def _free_twist(kin: Kinematics, pixels: list, segments: np.ndarray, basis: np.ndarray,
+                joint: int) -> np.ndarray:
+    """The rigid motion (6,) the pixels of ``segments`` ask for (one least-squares step, in
+    the span of ``basis``), as a twist in ``joint``'s frame before its rotation."""
+    ne = NormalEquations.zeros(basis.shape[1])
+    for view, seg, q, grad, r, w in pixels:
+        keep = segments[seg]
+        if keep.any():
+            A = rows(kin, view, CALIBRATED, seg[keep], q[keep], grad[keep])[:, :6]
+            ne.add(A @ basis, r[keep], w[keep])
+    step = basis @ solve(ne, 1e-3)
+    v_c, w = step[:3], step[3:]  # a world twist about the root's position c
+    M = kin.frames
+    c, RF, pF = M[0, :3, 3], M[kin.skeleton.parents[joint], :3, :3], M[joint, :3, 3]
+    return np.concatenate([RF.T @ (v_c + np.cross(w, pF - c)), RF.T @ w])
+
+
+def hinge_from_twists(W: np.ndarray, old_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Axis (3,) and the point (3,) on it nearest the frame's origin of the rank-1 twist
+    matrix W (6, T): its first left singular vector, scaled to a unit rotation part and
+    turned to agree with ``old_axis``."""
+    u = np.linalg.svd(W, full_matrices=False)[0][:, 0]
+    xi = u / np.linalg.norm(u[3:])
+    if xi[3:] @ old_axis < 0:
+        xi = -xi
+    return xi[3:], np.cross(xi[3:], xi[:3])
+
+
+def centre_from_twists(W: np.ndarray) -> np.ndarray:
+    """The point p (3,) all twists W (6, T) turn about: v(t) = p x w(t), least squares."""
+    A = np.concatenate([-se3.hat3(w) for w in W[3:].T])
+    return np.linalg.lstsq(A, np.concatenate(list(W[:3].T)), rcond=None)[0]
+
+
+def moved_joint(sk: Skeleton, joint: int, shift: np.ndarray, axis: np.ndarray | None = None
+                ) -> Skeleton:
+    """The skeleton with ``joint``'s centre moved by ``shift`` (its local frame, which is the
+    rest frame) and, for a hinge, the new axis; the body at rest stays where it was (its
+    children's offsets and end sites take the shift back; blobs are in the rest frame)."""
+    offsets = sk.offsets.copy()
+    offsets[joint] += shift
+    for c in sk.children(joint):
+        offsets[c] -= shift
+    ends = [list(e) for e in sk.end_sites]
+    ends[joint] = [e - shift for e in ends[joint]]
+    axes = sk.axes.copy()
+    if axis is not None:
+        axes[joint] = axis / np.linalg.norm(axis)
+    out = Skeleton(list(sk.names), sk.parents.copy(), offsets, list(sk.kinds), axes, ends)
+    out.blobs = sk.blobs
+    return out
+
+
+def carried_pose(old: Skeleton, new: Skeleton, pose: BodyPose) -> BodyPose:
+    """``pose`` of ``old`` as a pose of ``new`` that places the segments where they were:
+    each joint's rotation refitted, parents first, so that its segment's blobs (their axes'
+    ends) and its children's joints land where ``old`` put them."""
+    R = pose.rotations.copy()
+    g_old = old.segment_motions(old.joint_frames(pose.rotations, pose.root_position))
+    for j in range(1, new.n_joints):
+        if np.allclose(new.offsets[j], old.offsets[j]) and np.allclose(
+                new.rest_positions[j], old.rest_positions[j]):
+            continue
+        pts = [b.centre + b.Q[:, k] * b.radii[k] * sgn for b in new.blobs if b.joint == j
+               for k in range(3) for sgn in (-1, 1)] + [new.rest_positions[c]
+                                                       for c in new.children(j)]
+        if not pts:
+            continue
+        X = np.array(pts)
+        want = X @ g_old[j, :3, :3].T + g_old[j, :3, 3]
+        fit = least_squares(_placement_error, np.zeros(3), args=(new, R, pose, j, X, want))
+        R[j] = pose.rotations[j] @ se3.exp_so3(fit.x)
+    return BodyPose(R, pose.root_position.copy(), [v.copy() for v in pose.views])
+
+
+def _placement_error(x, sk: Skeleton, R: np.ndarray, pose: BodyPose, j: int, X: np.ndarray,
+                     want: np.ndarray) -> np.ndarray:
+    """Where segment j puts its points X with its rotation turned by x, less ``want``."""
+    Rj = R.copy()
+    Rj[j] = pose.rotations[j] @ se3.exp_so3(x)
+    g = sk.segment_motions(sk.joint_frames(Rj, pose.root_position))[j]
+    return (X @ g[:3, :3].T + g[:3, 3] - want).ravel()
+
+
+@dataclass
+class Refinement:
+    skeleton: Skeleton
+    initial: BodyPose  # the initial pose carried onto the refined skeleton
+    shifts: list[dict[str, float]] = field(default_factory=list)  # per round: joint -> m
+    turns: list[dict[str, float]] = field(default_factory=list)  # per round: hinge -> deg
+
+
+def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
+           joints: Sequence[str], settings: TrackerSettings | None = None,
+           planar: bool = False, rounds: int = 4, tolerance: float = 1e-3,
+           progress: Callable[[int, dict], None] | None = None) -> Refinement:
+    """Track ``images`` (calibrated views) from ``initial``, refine the centres (and hinge
+    axes) of ``joints``, track again, until no joint moves more than ``tolerance`` (world
+    units) or ``rounds`` are done."""
+    sk, pose = skeleton, initial
+    idx = []
+    for name in joints:
+        if name not in sk.names:
+            raise RefineError(f"no joint named '{name}' to refine")
+        j = sk.index(name)
+        if sk.kinds[j] not in (HINGE, BALL) or j == 0:
+            raise RefineError(f"'{name}' is not a hinge or ball joint: nothing to refine")
+        idx.append(j)
+    if planar and len(initial.views) != 1:
+        raise RefineError("planar refinement is for one view seeing the body side-on")
+    out = Refinement(sk, pose)
+    n = min(len(v) for v in images)
+    if n < 3:
+        raise RefineError(f"{n} frames are too few to refine a skeleton from (at least 3)")
+    frames = list(range(n))
+    for _ in range(rounds):
+        tracker = Tracker(sk, images, CALIBRATED, settings)
+        result = track(tracker, pose, frames)
+        if result.diverged_frames or len(result.frames) < n:
+            raise RefineError(f"tracking diverged at frame {result.diverged_frames[:1]}: "
+                              "refine over a stretch that tracks")
+        poses = [f.pose for f in result.frames]
+        shifts, turns, new = {}, {}, sk
+        for j in idx:
+            W = segment_twists(tracker, poses, frames, j, planar)
+            if sk.kinds[j] == HINGE:
+                # a hinge turns about R_j a in the frame before its rotation (R_j = R_j(0)
+                # exp(theta a)), so the axis found there is taken back through R_j(0)
+                R0 = poses[0].rotations[j]
+                axis, point = hinge_from_twists(W, R0 @ sk.axes[j])
+                axis = R0.T @ axis
+                if planar:  # the axis stays along the view; the centre moves across it
+                    axis = sk.axes[j]
+                    point = point - (R0 @ axis) * (point @ (R0 @ axis))
+                turns[sk.names[j]] = float(np.degrees(se3.angle_between_vectors(axis,
+                                                                             sk.axes[j])))
+            else:
+                axis, point = None, centre_from_twists(W)
+            new = moved_joint(new, j, point, axis)
+            shifts[sk.names[j]] = float(np.linalg.norm(point))
+        pose = carried_pose(sk, new, pose)
+        sk = new
+        out.shifts.append(shifts)
+        out.turns.append(turns)
+        if progress:
+            progress(len(out.shifts), shifts)
+        if max(shifts.values()) < tolerance:
+            break
+    out.skeleton, out.initial = sk, pose
+    return out
