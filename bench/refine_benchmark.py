@@ -1,0 +1,104 @@
+"""The skeleton refinement benchmark: the rendered CMU walk (bench/walk_footage.py), tracked
+with a skeleton whose left knee sits 4 cm forward of the capture's and whose right knee axis
+is turned 15 degrees, refined (core.refine), and scored before and after.
+
+    python bench/refine_benchmark.py [--cache .cache/walk] [--first 60] [--last 90]
+
+Frames are indices into the 30 fps footage (the default stretch is steady walking). Prints
+each refined joint's centre and axis error against the capture's skeleton and the legs'
+limb-direction errors when tracked with the skeleton before and after refinement.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import evaluate  # noqa: E402
+from walk_benchmark import RUNS  # noqa: E402
+from walk_footage import render, write_job  # noqa: E402
+
+from core import se3  # noqa: E402
+from core.bvh import read_bvh  # noqa: E402
+from core.job import load_job  # noqa: E402
+from core.pose import BodyPose  # noqa: E402
+from core.refine import carried_pose, moved_joint, refine  # noqa: E402
+from core.tracker import Tracker, track  # noqa: E402
+
+LEGS = ["left thigh", "right thigh", "left shank", "right shank"]
+
+
+def leg_errors(sk, truth_sk, images, initial, truth, frames) -> dict[str, float]:
+    """Mean limb-direction error (degrees) of each leg bone, tracked with ``sk``."""
+    res = track(Tracker(sk, images, "calibrated"), initial, frames)
+    R = np.array([f.pose.rotations for f in res.frames])
+    P = np.array([f.pose.root_position for f in res.frames])
+    got, want = evaluate.limb_vectors(sk, R, P), evaluate.limb_vectors(truth_sk, *truth)
+    return {k: float(np.degrees(se3.angle_between_vectors(got[k], want[k][:len(R)])).mean())
+            for k in LEGS}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
+    ap.add_argument("--first", type=int, default=60)
+    ap.add_argument("--last", type=int, default=90)
+    ap.add_argument("--rounds", type=int, default=3)
+    a = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
+    views, mode, _ = RUNS["3 views calibrated 30 fps"]
+    job = load_job(write_job(a.cache, "refine", views, mode, info["frames"], info["cameras"],
+                             {}, 4 / 120))
+    truth_sk = job.skeleton
+    T = read_bvh(a.cache / "truth.bvh").poses()
+    sel = slice(a.first, a.last)
+    truth = (T[0][sel], T[1][sel])
+    images = [v[sel] for v in job.images]
+    frames = list(range(a.last - a.first))
+    initial_true = BodyPose(truth[0][0].copy(), truth[1][0].copy(),
+                            [c.copy() for c in job.cameras])
+    lk, rk = truth_sk.index("LeftKnee"), truth_sk.index("RightKnee")
+    turned = se3.exp_so3(np.array([0, np.radians(15), 0])) @ truth_sk.axes[rk]
+    guess = moved_joint(moved_joint(truth_sk, lk, np.array([0.0, 0.0, 0.04])), rk,
+                        np.zeros(3), turned)
+    initial = carried_pose(truth_sk, guess, initial_true)  # lined up, centres wrong
+    result = refine(guess, images, initial, ["LeftKnee", "RightKnee"], rounds=a.rounds,
+                    tolerance=0.0)
+    refined = result.skeleton
+
+    print(f"frames {a.first}-{a.last - 1} of the 30 fps footage, {a.rounds} rounds\n")
+    print("| joint | centre error before | after | axis error before | after |")
+    print("|---|---|---|---|---|")
+    for j in (lk, rk):
+        def centre(s, j=j):
+            return 100 * np.linalg.norm(s.rest_positions[j] - truth_sk.rest_positions[j])
+
+        def axis(s, j=j):
+            return np.degrees(se3.angle_between_vectors(s.axes[j], truth_sk.axes[j]))
+
+        print(f"| {truth_sk.names[j]} | {centre(guess):.1f} cm | {centre(refined):.1f} cm |"
+              f" {axis(guess):.1f}° | {axis(refined):.1f}° |")
+    before = leg_errors(guess, truth_sk, images, initial, truth, frames)
+    after = leg_errors(refined, truth_sk, images, result.initial, truth, frames)
+    exact = leg_errors(truth_sk, truth_sk, images, initial_true, truth, frames)
+    print("\n| limb direction (°) | skeleton as guessed | refined | capture's skeleton |")
+    print("|---|---|---|---|")
+    for k in LEGS:
+        print(f"| {k} | {before[k]:.1f} | {after[k]:.1f} | {exact[k]:.1f} |")
+    print(f"| mean of the legs | {np.mean(list(before.values())):.1f} |"
+          f" {np.mean(list(after.values())):.1f} | {np.mean(list(exact.values())):.1f} |")
+    print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
