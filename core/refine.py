@@ -95,10 +95,13 @@ def hinge_from_twists(W: np.ndarray, old_axis: np.ndarray) -> tuple[np.ndarray, 
     return xi[3:], np.cross(xi[3:], xi[:3])
 
 
-def centre_from_twists(W: np.ndarray) -> np.ndarray:
-    """The point p (3,) all twists W (6, T) turn about: v(t) = p x w(t), least squares."""
+def centre_from_twists(W: np.ndarray, rcond: float = 0.1) -> np.ndarray:
+    """The point p (3,) all twists W (6, T) turn about: v(t) = p x w(t), least squares. A
+    ball that turned about one axis only (a knee kept as a ball) does not show where along
+    that axis its centre is: directions whose singular value is under ``rcond`` times the
+    largest are left where they were (minimum-norm solution)."""
     A = np.concatenate([-se3.hat3(w) for w in W[3:].T])
-    return np.linalg.lstsq(A, np.concatenate(list(W[:3].T)), rcond=None)[0]
+    return np.linalg.lstsq(A, np.concatenate(list(W[:3].T)), rcond=rcond)[0]
 
 
 def moved_joint(sk: Skeleton, joint: int, shift: np.ndarray, axis: np.ndarray | None = None

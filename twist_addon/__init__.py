@@ -12,12 +12,13 @@ from . import (
     overlay,
     panels,
     properties,
+    refine,
     retarget,
     smooth,
 )
 
-MODULES = (properties, operators, markers, fit, body, smooth, cycle, retarget, export, panels,
-           overlay)
+MODULES = (properties, operators, markers, fit, refine, body, smooth, cycle, retarget, export,
+           panels, overlay)
 
 
 def register():

@@ -88,6 +88,7 @@ class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
         row.scale_y = 1.4
         row.operator("twist.track", icon="TRACKING")
         layout.operator("twist.clear_track", icon="X")
+        layout.operator("twist.refine_skeleton", icon="BONE_DATA")
 
 
 class TWIST_PT_track_settings(_TwistPanel, bpy.types.Panel):

@@ -1,0 +1,136 @@
+"""Refine Skeleton: learn the armature's joint centres and hinge axes from the footage (the
+paper's section 2.7, ``core.refine``), write them into its rest pose, and track again so
+that the keys fit the new rest pose.
+
+A refined bone's head moves to the new centre (disconnected from its parent, whose tail
+stays, so the parent keeps its shape); a hinge's free axis turns by re-rolling the bone (a
+hinge about the bone's own length cannot turn). Children keep their heads.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from mathutils import Matrix, Vector
+
+from ..core.pose import CALIBRATED
+from ..core.refine import RefineError, refine
+from ..core.skeleton import BALL, HINGE, Skeleton
+from . import keyframes
+from .bridge import BridgeError, armature_rotations, skeleton_from_armature
+from .reporting import ArmatureAction
+from .track import TrackSession
+
+
+def write_rest_pose(arm, old: Skeleton, new: Skeleton) -> list[str]:
+    """Move the bones whose joint centre or hinge axis differs between the two skeletons
+    (core skeletons of ``arm``, world units and axes); returns their names."""
+    W = np.array(arm.matrix_world)
+    W_inv = np.linalg.inv(W)
+    changed = [j for j in range(1, old.n_joints)
+               if not np.allclose(old.rest_positions[j], new.rest_positions[j], atol=1e-7)
+               or not np.allclose(old.axes[j], new.axes[j], atol=1e-9)]
+    if not changed:
+        return []
+    view_layer = bpy.context.view_layer
+    active, view_layer.objects.active = view_layer.objects.active, arm
+    bpy.ops.object.mode_set(mode="EDIT")
+    bones = arm.data.edit_bones
+    for j in changed:
+        eb = bones[old.names[j]]
+        eb.use_connect = False
+        eb.head = Vector((W_inv @ np.append(new.rest_positions[j], 1))[:3])
+        if old.kinds[j] == HINGE:
+            free = [k for k in range(3) if not arm.pose.bones[eb.name].lock_rotation[k]][0]
+            axis = W_inv[:3, :3] @ new.axes[j]
+            along = np.array(eb.tail - eb.head)
+            if free == 2:
+                eb.align_roll(Vector(axis))
+            elif free == 0:  # local x along the axis: z = x cross y
+                eb.align_roll(Vector(np.cross(axis, along)))
+    bpy.ops.object.mode_set(mode="OBJECT")
+    view_layer.objects.active = active
+    return [old.names[j] for j in changed]
+
+
+def _set_pose(arm, sk: Skeleton, R: np.ndarray, root: np.ndarray) -> None:
+    """Pose the armature (unkeyed) at a core pose of ``sk``."""
+    Q, loc = armature_rotations(arm, sk, R, root)
+    for j, name in enumerate(sk.names):
+        pb = arm.pose.bones[name]
+        m = Matrix(Q[j].tolist())
+        if pb.rotation_mode == "QUATERNION":
+            pb.rotation_quaternion = m.to_quaternion()
+        elif pb.rotation_mode != "AXIS_ANGLE":
+            pb.rotation_euler = m.to_euler(pb.rotation_mode)
+    arm.pose.bones[sk.names[0]].location = loc
+
+
+def refine_armature(scene, only_selected: bool, planar: bool, rounds: int) -> dict[str, float]:
+    """Refine the scene armature's tracked joints (the selected bones only, if asked) over
+    the frames from the current one to the end (or start, tracking backward), one round at a
+    time, writing each round into the rest pose so that the bones' blobs follow their heads;
+    returns each refined bone's move in world units, over all rounds."""
+    start, moves = None, {}
+    for _ in range(rounds):
+        session = TrackSession.from_scene(scene)
+        tracker = session.tracker
+        if tracker.mode != CALIBRATED:
+            raise BridgeError("refining the skeleton needs calibrated views (Footage & Views "
+                              "> Views: Calibrated)")
+        arm, sk = session.armature, tracker.skeleton
+        start = sk.rest_positions if start is None else start
+        names = [n for n, k in zip(sk.names[1:], sk.kinds[1:]) if k in (HINGE, BALL)
+                 and (not only_selected or arm.pose.bones[n].select)]
+        if not names:
+            raise BridgeError("no tracked bone is selected to refine: select the bones "
+                              "whose joints to refine in Pose Mode" if only_selected
+                              else "no tracked bone to refine")
+        try:
+            result = refine(sk, tracker.seq.images, session.initial, names, tracker.settings,
+                            planar, rounds=1)
+        except RefineError as e:
+            raise BridgeError(str(e)) from None
+        moved = write_rest_pose(arm, sk, result.skeleton)
+        new_sk = skeleton_from_armature(arm)
+        _set_pose(arm, new_sk, result.initial.rotations, result.initial.root_position)
+        for n in moved:
+            j = sk.index(n)
+            moves[n] = float(np.linalg.norm(new_sk.rest_positions[j] - start[j]))
+        if max(result.shifts[0].values()) < 1e-3:
+            break
+    keyframes.clear(arm, new_sk, set(session.frames[1:]))
+    return moves
+
+
+class TWIST_OT_refine_skeleton(ArmatureAction, bpy.types.Operator):
+    """Learn the joint centres and hinge axes from the footage: track, refine, repeat; then
+    write them into the armature's rest pose and track again from the current frame"""
+
+    bl_idname = "twist.refine_skeleton"
+    bl_label = "Refine Skeleton"
+
+    only_selected: bpy.props.BoolProperty(
+        name="Only Selected Bones", default=True,
+        description="Refine the selected bones only (select them in Pose Mode); off, every "
+                    "tracked bone, which needs every limb tracked well")
+    planar: bpy.props.BoolProperty(
+        name="Planar", default=False,
+        description="One view seeing the body side-on: joints move in the image plane and "
+                    "hinge axes stay along the view")
+    rounds: bpy.props.IntProperty(
+        name="Rounds", default=3, min=1, max=20,
+        description="Track-and-refine rounds, at most (each tracks the whole range)")
+
+    def invoke(self, context, event):
+        return context.window_manager.invoke_props_dialog(self)
+
+    def run(self, context) -> str:
+        moved = refine_armature(context.scene, self.only_selected, self.planar, self.rounds)
+        if bpy.ops.twist.track() != {"FINISHED"}:
+            raise BridgeError("the refined skeleton could not be tracked again")
+        shown = ", ".join(f"{n} {100 * d:.1f} cm" for n, d in moved.items()) or "nothing"
+        return f"refined and tracked again; joints moved: {shown}"
+
+
+CLASSES = (TWIST_OT_refine_skeleton,)
