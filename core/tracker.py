@@ -368,14 +368,20 @@ class Tracker:
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         shape_cost, shape_parts)
 
+    def _pixel_weights(self, ps: _PointSet, ok: np.ndarray, r: np.ndarray, sigma: float
+                       ) -> np.ndarray:
+        """Weights of a point set's usable points ``ok`` with residuals ``r``: their rim
+        weight times the EM support posterior."""
+        return ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+
     def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
-                          sigmas: list[float], lv: int = 0) -> NormalEquations:
+                          sigmas: list[float], lv: int) -> NormalEquations:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
         and the silhouette's rows (each mismatched pixel's two coordinates)."""
         ne = NormalEquations.zeros(self.n_params)
         for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
             if len(ok):
-                w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+                w = self._pixel_weights(ps, ok, r, sigma)
                 ne.add(rows(kin, ps.view, self.mode, ps.seg_joint[ok], q, grad), r, w)
         s = self.settings
         g = 2**lv * self._grid(lv)  # full-resolution pixels per map pixel
@@ -411,7 +417,7 @@ class Tracker:
         image units: what the report calls a frame's residual."""
         num = den = 0.0
         for ps, sigma, (ok, _, _, r) in zip(sets, sigmas, smp.parts):
-            w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+            w = self._pixel_weights(ps, ok, r, sigma)
             num += float(np.sum(w * r * r))
             den += float(np.sum(w))
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
@@ -451,7 +457,7 @@ class Tracker:
         smp = self._sample(est, kin, sets, levels, 0, sigmas)
         out = []
         for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
-            w = ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+            w = self._pixel_weights(ps, ok, r, sigma)
             out.append((ps.view, ps.seg_joint[ok], q, grad, r, w))
         return out
 
