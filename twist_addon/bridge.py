@@ -113,6 +113,22 @@ def armature_rotations(arm, sk: Skeleton, R: np.ndarray, root_position: np.ndarr
     return Q, loc
 
 
+def set_pose(arm, sk: Skeleton, R: np.ndarray, root_position: np.ndarray) -> None:
+    """Pose the armature (unkeyed) at a core pose: each bone's rotation in its own rotation
+    mode (an axis-angle bone is left as it is) and the root bone's location."""
+    from mathutils import Matrix
+
+    Q, loc = armature_rotations(arm, sk, R, root_position)
+    for j, name in enumerate(sk.names):
+        pb = arm.pose.bones[name]
+        m = Matrix(Q[j].tolist())
+        if pb.rotation_mode == "QUATERNION":
+            pb.rotation_quaternion = m.to_quaternion()
+        elif pb.rotation_mode != "AXIS_ANGLE":
+            pb.rotation_euler = m.to_euler(pb.rotation_mode)
+    arm.pose.bones[sk.names[0]].location = loc
+
+
 def view_from_camera(cam, scene) -> View:
     """The scaled orthographic view of an orthographic camera at the scene's resolution."""
     if cam.type != "CAMERA":

@@ -13,15 +13,14 @@ from pathlib import Path
 
 import bpy
 import numpy as np
-from mathutils import Matrix
 
 from ..core.init_fit import FitError, fit_pose
 from ..core.job import world_root
 from ..core.pose import BodyPose
 from .bridge import (
     BridgeError,
-    armature_rotations,
     pose_from_armature,
+    set_pose,
     skeleton_from_armature,
     view_from_camera,
 )
@@ -113,14 +112,7 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
         sk = skeleton_from_armature(arm)
     R_fit = res.pose.rotations.copy()
     R_fit[0], root_fit = world_root(mode, views[0], res.pose)
-    Q, loc = armature_rotations(arm, sk, R_fit, root_fit)
-    for j, name in enumerate(sk.names):
-        pb = arm.pose.bones[name]
-        if pb.rotation_mode == "QUATERNION":
-            pb.rotation_quaternion = Matrix(Q[j].tolist()).to_quaternion()
-        elif pb.rotation_mode != "AXIS_ANGLE":
-            pb.rotation_euler = Matrix(Q[j].tolist()).to_euler(pb.rotation_mode)
-    arm.pose.bones[sk.names[0]].location = loc
+    set_pose(arm, sk, R_fit, root_fit)
     return res.residual_px, changed
 
 

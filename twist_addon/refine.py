@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from mathutils import Matrix, Vector
+from mathutils import Vector
 
 from ..core.pose import CALIBRATED
 from ..core.refine import RefineError, refine
 from ..core.skeleton import BALL, HINGE, Skeleton
 from . import keyframes
-from .bridge import BridgeError, armature_rotations, skeleton_from_armature
+from .bridge import BridgeError, set_pose, skeleton_from_armature
 from .reporting import ArmatureAction
 from .track import TrackSession
 
@@ -53,19 +53,6 @@ def write_rest_pose(arm, old: Skeleton, new: Skeleton) -> list[str]:
     return [old.names[j] for j in changed]
 
 
-def _set_pose(arm, sk: Skeleton, R: np.ndarray, root: np.ndarray) -> None:
-    """Pose the armature (unkeyed) at a core pose of ``sk``."""
-    Q, loc = armature_rotations(arm, sk, R, root)
-    for j, name in enumerate(sk.names):
-        pb = arm.pose.bones[name]
-        m = Matrix(Q[j].tolist())
-        if pb.rotation_mode == "QUATERNION":
-            pb.rotation_quaternion = m.to_quaternion()
-        elif pb.rotation_mode != "AXIS_ANGLE":
-            pb.rotation_euler = m.to_euler(pb.rotation_mode)
-    arm.pose.bones[sk.names[0]].location = loc
-
-
 def refine_armature(scene, only_selected: bool, planar: bool, rounds: int) -> dict[str, float]:
     """Refine the scene armature's tracked joints (the selected bones only, if asked) over
     the frames from the current one to the end (or start, tracking backward), one round at a
@@ -93,7 +80,7 @@ def refine_armature(scene, only_selected: bool, planar: bool, rounds: int) -> di
             raise BridgeError(str(e)) from None
         moved = write_rest_pose(arm, sk, result.skeleton)
         new_sk = skeleton_from_armature(arm)
-        _set_pose(arm, new_sk, result.initial.rotations, result.initial.root_position)
+        set_pose(arm, new_sk, result.initial.rotations, result.initial.root_position)
         for n in moved:
             j = sk.index(n)
             moves[n] = float(np.linalg.norm(new_sk.rest_positions[j] - start[j]))
