@@ -67,14 +67,15 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
                 raise FitError(f"view {c + 1}: no joint named '{name}'")
     dof_joint, dof_axis = sk.dof_joints_and_axes()
     joints = sorted(set(dof_joint.tolist()))
-    # a bone whose two ends are both clicked gets its own length (shared with its mirror
-    # twin); every other bone scales with one common factor, so that unseen bones do not
-    # soak up the clicks' noise
+    # a bone on the way from the root to a clicked joint gets its own length (shared with
+    # its mirror twin): even an unclicked trunk bone decides where the clicked shoulders can
+    # be (one common factor for them left the upper arms 2 degrees off with exact clicks);
+    # bones below every click scale with one common factor, so that they do not soak up noise
     clicked = {sk.index(n) for v in clicks for n in v}
+    below = {a for c in clicked for a in sk.ancestors(c)}
 
     def group_key(j: int) -> str:
-        both = j in clicked and sk.parents[j] in clicked
-        return symmetry_key(sk.names[j]) if both else "*body"
+        return symmetry_key(sk.names[j]) if j in below else "*body"
 
     bones = [j for j in range(1, sk.n_joints) if np.linalg.norm(sk.offsets[j]) > 1e-9]
     groups = sorted({group_key(j) for j in bones})
