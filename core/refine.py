@@ -1,17 +1,18 @@
 """The skeleton learned from the footage (paper section 2.7): joint centres and hinge axes
 refined from a tracked sequence.
 
-For one joint and each pair of consecutive frames, the motion of every segment the joint
-moves is the joint's tracked step plus a free rigid correction (a 6-vector twist, least
-squares over those segments' pixels at the tracked pose of the later frame), so that what the
-current skeleton cannot do shows. Written in the joint's frame before its rotation (the
-parent's axes, at the joint), a hinge's twists over time are one twist scaled by its angular
-velocity: the 6 x T matrix of them has rank 1,
-and its first singular vector, scaled so that its rotation part is a unit vector, is the
-hinge's twist (v, w) = (p x w, w): its axis w and the point p on it nearest the old centre.
-A ball joint turns about varying axes through one centre p, so v(t) = p x w(t) gives p by
-least squares. The refined joints are moved there (its children's offsets compensate, so the
-body at rest is unchanged), and the footage is tracked again, until no joint moves.
+For one joint and each pair of consecutive frames, the motion of the segments the joint
+moves, relative to its parent's, is the joint's tracked step plus the free rigid corrections
+(6-vector twists, least squares over each group's pixels at the tracked pose of the later
+frame) those segments ask for beyond it, less the parent's: what the current skeleton cannot
+do shows. Written in the joint's frame before its rotation (the parent's axes, at the joint),
+a hinge's twists over time are one twist scaled by its angular velocity: the 6 x T matrix of
+them has rank 1, and its first singular vector, scaled so that its rotation part is a unit
+vector, is the hinge's twist (v, w) = (p x w, w): its axis w and the point p on it nearest
+the old centre. A ball joint turns about varying axes through one centre p, so v(t) =
+p x w(t) gives p by least squares. The refined joints are moved there (its children's
+offsets compensate, so the body at rest is unchanged), and the footage is tracked again,
+until no joint moves.
 
 Calibrated views (one world frame). Planar mode, for a body seen side-on by one view: the
 twists are kept in the image plane (translation along the image axes, rotation about the view
@@ -51,12 +52,12 @@ def segment_twists(tracker: Tracker, poses: Sequence[BodyPose], frames: Sequence
         R = poses[0].views[0].pose.R
         basis = np.zeros((6, 3))
         basis[:3, 0], basis[:3, 1], basis[3:, 2] = R[0], R[1], R[2]
+    own = np.zeros(sk.n_joints, dtype=bool)  # the parent's own segment
+    own[parent] = True
     out = []
     for t in range(1, len(poses)):
         kin = Kinematics(sk, poses[t])
         pixels = tracker.frame_pixels(poses[t - 1], frames[t - 1], poses[t], frames[t])
-        own = np.zeros(sk.n_joints, dtype=bool)
-        own[parent] = True
         # the tracked step turns the segments about the joint's centre; what the pixels of
         # the joint's segments ask for beyond it, less what its parent's ask for, is what the
         # skeleton could not do
