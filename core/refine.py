@@ -21,7 +21,7 @@ direction), and a hinge's axis stays along the view direction.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -165,8 +165,7 @@ class Refinement:
 
 def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
            joints: Sequence[str], settings: TrackerSettings | None = None,
-           planar: bool = False, rounds: int = 4, tolerance: float = 1e-3,
-           progress: Callable[[int, dict], None] | None = None) -> Refinement:
+           planar: bool = False, rounds: int = 4, tolerance: float = 1e-3) -> Refinement:
     """Track ``images`` (calibrated views) from ``initial``, refine the centres (and hinge
     axes) of ``joints``, track again, until no joint moves more than ``tolerance`` (world
     units) or ``rounds`` are done."""
@@ -190,8 +189,9 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
         tracker = Tracker(sk, images, CALIBRATED, settings)
         result = track(tracker, pose, frames)
         if result.diverged_frames or len(result.frames) < n:
-            raise RefineError(f"tracking diverged at frame {result.diverged_frames[:1]}: "
-                              "refine over a stretch that tracks")
+            where = result.diverged_frames[0] if result.diverged_frames else len(result.frames)
+            raise RefineError(f"tracking diverged at frame {where} of the range: refine over "
+                              "a stretch that tracks")
         poses = [f.pose for f in result.frames]
         shifts, turns, new = {}, {}, sk
         for j in idx:
@@ -215,8 +215,6 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
         sk = new
         out.shifts.append(shifts)
         out.turns.append(turns)
-        if progress:
-            progress(len(out.shifts), shifts)
         if max(shifts.values()) < tolerance:
             break
     out.skeleton, out.initial = sk, pose
