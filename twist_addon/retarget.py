@@ -118,6 +118,11 @@ def retarget(source, target, mapping: dict[str, str], frames: list[int], scene,
     return len(pairs)
 
 
+def _preset_property(side: str, default: str, which: str):
+    return bpy.props.EnumProperty(name=f"{side} Names", items=_PRESET_ITEMS, default=default,
+                                  description=f"How the {which} armature's bones are named")
+
+
 class TWIST_OT_retarget(ArmatureAction, bpy.types.Operator):
     """Copy the tracked motion onto another armature through a bone map, over the scene's
     frame range"""
@@ -127,12 +132,8 @@ class TWIST_OT_retarget(ArmatureAction, bpy.types.Operator):
 
     target: bpy.props.StringProperty(
         name="Target", description="The armature object to key (by name)")
-    source_preset: bpy.props.EnumProperty(
-        name="Source Names", items=_PRESET_ITEMS, default="CMU",
-        description="How the tracked armature's bones are named")
-    target_preset: bpy.props.EnumProperty(
-        name="Target Names", items=_PRESET_ITEMS, default="RIGIFY",
-        description="How the target armature's bones are named")
+    source_preset: _preset_property("Source", "CMU", "tracked")
+    target_preset: _preset_property("Target", "RIGIFY", "target")
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self)
@@ -165,12 +166,8 @@ class TWIST_OT_load_bone_map(bpy.types.Operator):
     bl_label = "Load Bone Map"
     bl_options = {"REGISTER", "UNDO"}
 
-    source_preset: bpy.props.EnumProperty(
-        name="Source Names", items=_PRESET_ITEMS, default="CMU",
-        description="How the tracked armature's bones are named")
-    target_preset: bpy.props.EnumProperty(
-        name="Target Names", items=_PRESET_ITEMS, default="RIGIFY",
-        description="How the target armature's bones are named")
+    source_preset: _preset_property("Source", "CMU", "tracked")
+    target_preset: _preset_property("Target", "RIGIFY", "target")
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self)

@@ -7,21 +7,28 @@ import pytest
 from support.views import three_view_scene as _scene_with_views
 
 
+def _random_pose(bpy, arm, sk, rng, ball: float, hinge: float) -> None:
+    """Turn every ball joint up to ``ball`` radians about a random axis, every hinge between
+    0.2 and ``hinge`` radians."""
+    from mathutils import Quaternion
+
+    for name, kind in zip(sk.names, sk.kinds):
+        pb = arm.pose.bones[name]
+        if kind == "ball":
+            pb.rotation_quaternion = Quaternion(rng.normal(0, 0.3, 3), ball)
+        elif kind == "hinge":
+            pb.rotation_euler[2] = rng.uniform(0.2, hinge)
+    bpy.context.view_layer.update()
+
+
 def test_fitting_markers_recovers_the_pose(bpy_module, registered, tmp_path):
     bpy = bpy_module
-    from mathutils import Quaternion
 
     scene, arm = _scene_with_views(bpy, registered)
     tw = registered.twist_addon
     sk = tw.bridge.skeleton_from_armature(arm)
     rng = np.random.default_rng(0)
-    for name, kind in zip(sk.names, sk.kinds):
-        pb = arm.pose.bones[name]
-        if kind == "ball":
-            pb.rotation_quaternion = Quaternion(rng.normal(0, 0.3, 3), 0.5)
-        elif kind == "hinge":
-            pb.rotation_euler[2] = rng.uniform(0.2, 1.0)
-    bpy.context.view_layer.update()
+    _random_pose(bpy, arm, sk, rng, 0.5, 1.0)
     R, root = tw.bridge.pose_from_armature(arm, sk)
     truth = sk.world_positions(R, root)
     rows = ["view,bone,x,y"]
@@ -65,7 +72,6 @@ def test_fitting_bone_lengths_writes_them_into_the_rest_pose(bpy_module, registe
     bones, 25 px long, within 6 %), keeps every bone's rest direction and roll, and its joints
     land within a centimetre."""
     bpy = bpy_module
-    from mathutils import Quaternion
 
     scene, arm = _scene_with_views(bpy, registered)
     tw = registered.twist_addon
@@ -78,13 +84,7 @@ def test_fitting_bone_lengths_writes_them_into_the_rest_pose(bpy_module, registe
     assert true_lengths["LeftHip"] == pytest.approx(1.08 * lengths_before["LeftHip"])
     sk = tw.bridge.skeleton_from_armature(arm)
     rng = np.random.default_rng(1)
-    for name, kind in zip(sk.names, sk.kinds):
-        pb = arm.pose.bones[name]
-        if kind == "ball":
-            pb.rotation_quaternion = Quaternion(rng.normal(0, 0.3, 3), 0.4)
-        elif kind == "hinge":
-            pb.rotation_euler[2] = rng.uniform(0.2, 0.9)
-    bpy.context.view_layer.update()
+    _random_pose(bpy, arm, sk, rng, 0.4, 0.9)
     truth = sk.world_positions(*tw.bridge.pose_from_armature(arm, sk))
     for v in scene.twist.views:
         view = tw.bridge.view_from_camera(v.camera, scene)
