@@ -1,6 +1,6 @@
 """Exporting the tracked motion: BVH and FBX through Blender's own exporters, also from
-File > Export. Scripted, they take ``filepath`` and act on the scene's tracked armature (or the
-active armature) over the scene's frame range."""
+File > Export. Scripted, they take ``filepath`` and act on the active armature (or, when the
+active object is not one, the scene's tracked armature) over the scene's frame range."""
 
 from __future__ import annotations
 
@@ -11,14 +11,15 @@ from .keyframes import channelbag
 
 
 def _armature(context, name: str = ""):
-    """The armature named, else the tracked one, else the active object if an armature."""
+    """The armature named, else the active object if an armature (as Blender's exporters
+    act on what is selected), else the tracked one."""
     if name:
         obj = bpy.data.objects.get(name)
         return obj if obj is not None and obj.type == "ARMATURE" else None
-    arm = context.scene.twist.armature
-    if arm is None and context.active_object and context.active_object.type == "ARMATURE":
-        arm = context.active_object
-    return arm
+    active = context.active_object
+    if active is not None and active.type == "ARMATURE":
+        return active
+    return context.scene.twist.armature
 
 
 def _frame_range(arm, scene, only_cycle: bool) -> tuple[int, int]:
@@ -50,8 +51,8 @@ class _Export(ExportHelper):
     bl_options = {"REGISTER"}
 
     armature: bpy.props.StringProperty(
-        name="Armature", description="The armature to export, by name (empty: the tracked "
-                                     "one); a retargeted rig, for instance")
+        name="Armature", description="The armature to export, by name (empty: the active "
+                                     "armature, else the tracked one)")
     only_cycle: bpy.props.BoolProperty(
         name="Only One Cycle", default=False,
         description="Export just the walk cycle's frames instead of the scene's range")
@@ -64,21 +65,27 @@ class _Export(ExportHelper):
         arm = _armature(context, self.armature)
         if arm is None:
             self.report({"ERROR"}, f"no armature '{self.armature}' to export" if self.armature
-                        else "no armature to export: set Twist Mocap > Armature")
+                        else "no armature to export: select one, or set Twist Mocap > "
+                        "Armature")
             return {"CANCELLED"}
         try:
             first, last = _frame_range(arm, context.scene, self.only_cycle)
         except ValueError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
+        layer = context.view_layer
+        selected, active = [o for o in layer.objects if o.select_get()], layer.objects.active
         _select_only(context, arm)
         scene = context.scene
         kept = scene.frame_start, scene.frame_end
         scene.frame_start, scene.frame_end = first, last
         try:
             result = self.export(context, scene)
-        finally:
+        finally:  # the user's frame range and selection, as they were
             scene.frame_start, scene.frame_end = kept
+            for o in layer.objects:
+                o.select_set(o in selected)
+            layer.objects.active = active
         if result == {"FINISHED"}:
             self.report({"INFO"}, f"exported '{arm.name}' frames {first}-{last} to "
                                   f"{self.filepath}")

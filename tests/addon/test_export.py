@@ -158,3 +158,28 @@ def test_export_one_cycle_of_a_chosen_armature(bpy_module, registered, tmp_path)
     assert (scene.frame_start, scene.frame_end) == (1, 60)  # the scene's range is untouched
     with pytest.raises(RuntimeError, match="'Walker' has no animation to export"):
         bpy.ops.twist.export_bvh(filepath=str(out), only_cycle=True)
+
+
+def test_export_acts_on_the_active_armature_else_the_tracked_one(bpy_module, registered,
+                                                                 tmp_path):
+    """As Blender's exporters do: the selected (active) armature is what File > Export writes;
+    with no armature active, the scene's tracked one."""
+    bpy = bpy_module
+    from support.walking import walking_template
+
+    scene, human = walking_template(bpy, registered, frames=5)
+    bpy.ops.twist.add_template_armature(template="WALKER")
+    walker = scene.twist.armature
+    scene.twist.armature = human  # the human is tracked, the walker active
+    assert bpy.context.view_layer.objects.active == walker
+    out = tmp_path / "active.bvh"
+    assert bpy.ops.twist.export_bvh(filepath=str(out)) == {"FINISHED"}
+    assert "LeftAnkle" in read_bvh(out).names  # the walker's
+    bpy.context.view_layer.objects.active = None
+    assert bpy.ops.twist.export_bvh(filepath=str(out)) == {"FINISHED"}
+    assert "LeftAnkle" not in read_bvh(out).names and "LeftKnee" in read_bvh(out).names
+    human.select_set(True)
+    bpy.context.view_layer.objects.active = human
+    assert bpy.ops.twist.export_bvh(filepath=str(out), armature=walker.name) == {"FINISHED"}
+    assert bpy.context.view_layer.objects.active == human  # the selection is left as it was
+    assert human.select_get() and not walker.select_get()
