@@ -116,12 +116,18 @@ def lowpass(curves: np.ndarray, cutoff_hz: float, fps: float) -> np.ndarray:
                     padlen=min(len(curves) - 1, 3 * max(len(a), len(b))))
 
 
-def lowpass_quaternions(q: np.ndarray, cutoff_hz: float, fps: float) -> np.ndarray:
-    """Low-pass a rotation track (F, 4): each quaternion first put on the side of its
-    predecessor (q and -q are one rotation), then filtered and normalised."""
+def continuous_quaternions(q: np.ndarray) -> np.ndarray:
+    """A rotation track (F, 4) with each quaternion put on the side of its predecessor (q and
+    -q are one rotation), so that the components change smoothly."""
     q = np.asarray(q, float).copy()
     for i in range(1, len(q)):
         if q[i] @ q[i - 1] < 0:
             q[i] = -q[i]
-    f = lowpass(q, cutoff_hz, fps)
+    return q
+
+
+def lowpass_quaternions(q: np.ndarray, cutoff_hz: float, fps: float) -> np.ndarray:
+    """Low-pass a rotation track (F, 4): made continuous (``continuous_quaternions``), then
+    filtered and normalised."""
+    f = lowpass(continuous_quaternions(q), cutoff_hz, fps)
     return f / np.linalg.norm(f, axis=1, keepdims=True)

@@ -12,7 +12,14 @@ import bpy
 import numpy as np
 from mathutils import Euler, Matrix, Quaternion
 
-from ..core.cycles import complete_by_mirroring, gait_period, make_loop, mirror_poses, sample
+from ..core.cycles import (
+    complete_by_mirroring,
+    continuous_quaternions,
+    gait_period,
+    make_loop,
+    mirror_poses,
+    sample,
+)
 from .bridge import BridgeError, skeleton_from_armature
 from .keyframes import TRACKED, channelbag, tracked_fcurves
 from .reporting import ArmatureAction
@@ -27,6 +34,10 @@ class BodyMirror:
     def __init__(self, arm, curves: list, recorded: np.ndarray, half: float):
         self.arm, self.curves = arm, curves
         self.bones = list(dict.fromkeys(_bone(fc) for fc in curves))
+        # per bone, its channels: (column, attribute, index)
+        self.channels = {b: [(c, fc.data_path.rsplit(".", 1)[1], fc.array_index)
+                             for c, fc in enumerate(curves) if _bone(fc) == b]
+                         for b in self.bones}
         tracked = set(self.bones)
         partners = []
         for b in self.bones:
@@ -69,13 +80,13 @@ class BodyMirror:
         for i, b in enumerate(self.bones):
             pb = self.arm.pose.bones[b]
             for f, row in enumerate(rows):
-                quat, euler, loc = Quaternion(pb.rotation_quaternion), Euler(
-                    pb.rotation_euler), np.array(pb.location)
-                for fc, v in zip(self.curves, row):
-                    if _bone(fc) == b:
-                        attr = fc.data_path.rsplit(".", 1)[1]
-                        {"rotation_quaternion": quat, "rotation_euler": euler,
-                         "location": loc}[attr][fc.array_index] = v
+                value = {"rotation_quaternion": Quaternion(pb.rotation_quaternion),
+                         "rotation_euler": Euler(pb.rotation_euler),
+                         "location": np.array(pb.location)}
+                for c, attr, index in self.channels[b]:
+                    value[attr][index] = row[c]
+                quat, euler, loc = (value[k] for k in ("rotation_quaternion",
+                                                       "rotation_euler", "location"))
                 if pb.rotation_mode == "QUATERNION":
                     Q[f, i] = np.array(quat.normalized().to_matrix())
                 else:
@@ -90,19 +101,17 @@ class BodyMirror:
         Q = self.rest.transpose(0, 2, 1) @ turns @ self.rest
         out = like.copy()
         for f in range(len(out)):
-            values = {}
             for i, b in enumerate(self.bones):
                 pb = self.arm.pose.bones[b]
                 m = Matrix(Q[f, i].tolist())
                 if pb.rotation_mode == "QUATERNION":
-                    values[b, "rotation_quaternion"] = m.to_quaternion()
+                    value = {"rotation_quaternion": m.to_quaternion()}
                 else:
-                    values[b, "rotation_euler"] = m.to_euler(pb.rotation_mode,
-                                                             pb.rotation_euler)
+                    value = {"rotation_euler": m.to_euler(pb.rotation_mode, pb.rotation_euler)}
                 if i == 0:
-                    values[b, "location"] = self.rest[0].T @ (heads[f] - self.head)
-            for c, fc in enumerate(self.curves):
-                out[f, c] = values[_bone(fc), fc.data_path.rsplit(".", 1)[1]][fc.array_index]
+                    value["location"] = self.rest[0].T @ (heads[f] - self.head)
+                for c, attr, index in self.channels[b]:
+                    out[f, c] = value[attr][index]
         return out
 
 
@@ -111,13 +120,12 @@ def _bone(fc) -> str:
 
 
 def _continuous_quaternions(values: np.ndarray, curves: list) -> None:
-    """Flip each bone's quaternion rows, in place, onto the side of the row before."""
+    """Put each bone's quaternion rows, in place, on the side of the row before."""
     for b in dict.fromkeys(_bone(fc) for fc in curves):
         cols = [c for c, fc in enumerate(curves)
                 if _bone(fc) == b and fc.data_path.endswith("rotation_quaternion")]
-        for f in range(1, len(values)):
-            if len(cols) == 4 and values[f, cols] @ values[f - 1, cols] < 0:
-                values[f, cols] *= -1
+        if len(cols) == 4:
+            values[:, cols] = continuous_quaternions(values[:, cols])
 
 
 def make_cycle(arm, first: int, last: int, period: float | None = None,
