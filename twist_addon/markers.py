@@ -38,11 +38,11 @@ def pixel_of_point(cam, scene, point) -> np.ndarray:
     return view_from_camera(cam, scene).project(np.asarray(point, float))
 
 
-def point_of_pixel(cam, scene, pixel, depth_point) -> np.ndarray:
-    """The world point on ``pixel``'s ray through ``cam`` nearest to ``depth_point`` (where
-    to draw a marker so that it sits among the bones)."""
-    origin, d = view_from_camera(cam, scene).ray(np.asarray(pixel, float))
-    return origin + d * float((np.asarray(depth_point, float) - origin) @ d)
+def point_of_pixel(cam, scene, pixels, depth_point) -> np.ndarray:
+    """The world points (..., 3) on the rays of ``pixels`` (..., 2) through ``cam`` nearest
+    to ``depth_point`` (where to draw markers so that they sit among the bones)."""
+    origin, d = view_from_camera(cam, scene).ray(np.asarray(pixels, float))
+    return origin + d * ((np.asarray(depth_point, float) - origin) @ d)[..., None]
 
 
 def next_bone(arm, bone: str) -> str:

@@ -45,7 +45,7 @@ def marker_crosses(cam, scene, markers: dict, depth_point) -> np.ndarray:
             ends += [p - d, p + d]
     if not ends:
         return np.zeros((0, 3))
-    return np.array([point_of_pixel(cam, scene, e, depth_point) for e in ends])
+    return point_of_pixel(cam, scene, np.array(ends), depth_point)  # one camera read
 
 
 def _draw():
