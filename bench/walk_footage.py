@@ -45,10 +45,11 @@ CAPTURE_FPS = 120
 JOINTS = {
     "LeftHip": "ball", "RightHip": "ball", "LeftShoulder": "ball", "RightShoulder": "ball",
     "Neck": "ball",
-    "LeftKnee": {"kind": "hinge", "axis": [0.94, 0.34, 0.0]},
-    "RightKnee": {"kind": "hinge", "axis": [0.94, -0.34, 0.0]},
-    "LeftElbow": {"kind": "hinge", "axis": [0.87, 0.0, -0.5]},
-    "RightElbow": {"kind": "hinge", "axis": [0.87, 0.0, 0.5]},
+    # limits as anatomy has them (the knees bend one way, the elbows the other, from straight)
+    "LeftKnee": {"kind": "hinge", "axis": [0.94, 0.34, 0.0], "limits": [0, 160]},
+    "RightKnee": {"kind": "hinge", "axis": [0.94, -0.34, 0.0], "limits": [0, 160]},
+    "LeftElbow": {"kind": "hinge", "axis": [0.87, 0.0, -0.5], "limits": [-160, 0]},
+    "RightElbow": {"kind": "hinge", "axis": [0.87, 0.0, 0.5], "limits": [-160, 0]},
 }
 # blob short radii a user would set to line the blobs up with this body (metres)
 BLOBS = {

@@ -121,7 +121,8 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
         return R, root, offsets, views, factors
 
     def positions(R, root, offsets):
-        fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites)
+        fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites,
+                          limits=sk.limits)
         return fitted, fitted.world_positions(R, root)
 
     def residuals(x):

@@ -6,7 +6,9 @@ never removed or changed in meaning. Relative paths are relative to the job file
 .. code-block:: json
 
     {"skeleton": {"bvh": "body.bvh",
-                  "joints": {"LeftHip": "ball", "LeftKnee": {"kind": "hinge", "axis": [1, 0, 0]}},
+                  "joints": {"LeftHip": "ball",
+                             "LeftKnee": {"kind": "hinge", "axis": [1, 0, 0],
+                                          "limits": [0, 150]}},
                   "blobs": {"Chest": {"radius": 0.12}, "LeftCollar": false}},
      "initial": {"bvh": "body.bvh", "frame": 0},
      "views": [{"images": "lateral/*.png",
@@ -18,7 +20,9 @@ never removed or changed in meaning. Relative paths are relative to the job file
 
 A view's ``images`` are a glob, a list of image files or one movie file (.mp4, .mov, .avi...).
 A camera maps a world point X (the BVH's units) to pixel = scale * (R X + t)[:2] + center,
-x right, y down. Joints not named under ``joints`` keep their initial rotation. A blob entry
+x right, y down. Joints not named under ``joints`` keep their initial rotation; a hinge's
+optional ``limits`` bound its angle in degrees (the rotation vector's component along the
+axis, 0 at the BVH's rest pose), so that the tracker never bends it backwards. A blob entry
 sets the short radius (``radius``, or two ``radii``) and optionally the full ``length`` along
 the bone (centred on the bone) of every blob of that joint, or is ``false`` to drop them.
 """
@@ -148,6 +152,12 @@ def _apply_joints(sk: Skeleton, spec, where: str) -> None:
             if np.linalg.norm(a) < 1e-9:
                 raise JobError(f"{where}.{name}.axis: the axis must not be zero")
             sk.axes[j] = a / np.linalg.norm(a)
+            if "limits" in js:
+                lo, hi = _vector(js["limits"], 2, f"{where}.{name}.limits")
+                if not lo < hi:
+                    raise JobError(f"{where}.{name}.limits: expected [lowest, highest] angle in "
+                                   f"degrees, lowest first, got {js['limits']!r}")
+                sk.limits[j] = np.radians([lo, hi])
 
 
 def _apply_blobs(sk: Skeleton, spec, where: str) -> None:

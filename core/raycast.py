@@ -153,3 +153,15 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     origin = o00[0] + pixels[:, :1] * ox + pixels[:, 1:] * oy
     hits = Hits(label[vv, uu], dep, origin + dep[:, None] * d, rim[vv, uu])
     return pixels, hits, box
+
+
+def shadows(view: View, A: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Outlines of ellipsoids under the view's orthographic projection: pixel p is covered by
+    ellipsoid e when (p - c_e)^T P_e (p - c_e) <= 1. Takes world-to-normalised maps A (..., 3, 3)
+    and world centres C (..., 3) (``blob_frames``); returns pixel centres c (..., 2) and the
+    2x2 forms P (..., 2, 2): the camera-frame quadratic with depth eliminated."""
+    R, s = view.pose.R, view.pose.s
+    AR = A @ R.T / s  # normalised coordinates per scaled-camera unit
+    M = np.swapaxes(AR, -1, -2) @ AR
+    P = M[..., :2, :2] - M[..., :2, 2:] * M[..., 2:, :2] / M[..., 2:, 2:]
+    return view.project(C), P

@@ -50,6 +50,7 @@ class Skeleton:
     axes: np.ndarray | None = None  # (J, 3) hinge axes in the joint's local frame
     end_sites: list[list[np.ndarray]] = field(default_factory=list)
     blobs: list[Ellipsoid] = field(default_factory=list)
+    limits: np.ndarray | None = None  # (J, 2) hinge angle range, radians (-inf, inf: free)
 
     def __post_init__(self):
         J = len(self.names)
@@ -59,6 +60,8 @@ class Skeleton:
             self.kinds = [FIXED] * J
         if self.axes is None:
             self.axes = np.tile([1.0, 0.0, 0.0], (J, 1))
+        if self.limits is None:
+            self.limits = np.tile([-np.inf, np.inf], (J, 1))
         if not self.end_sites:
             self.end_sites = [[] for _ in range(J)]
         for j, p in enumerate(self.parents):
@@ -136,6 +139,11 @@ class Skeleton:
                 joints.append(j)
                 axes.append(a / np.linalg.norm(a))
         return np.array(joints, dtype=int), np.array(axes, dtype=float).reshape(-1, 3)
+
+    def hinge_angle(self, j: int, rotation: np.ndarray) -> float:
+        """Hinge j's angle in a local rotation: its rotation vector along the axis (radians;
+        0 at the BVH's rest pose), the quantity ``limits`` bound."""
+        return float(se3.log_so3(rotation) @ self.axes[j])
 
     def dof_names(self) -> list[str]:
         names = []

@@ -30,7 +30,8 @@ from . import raycast
 from . import silhouette as sil
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
-from .skeleton import Skeleton
+from .search import LimbSearch
+from .skeleton import HINGE, Skeleton
 from .solver import (
     DegenerateSystem,
     NormalEquations,
@@ -85,6 +86,10 @@ class TrackerSettings:
                               "than brightness reaches. Needs cameras that stand still")
     silhouette_cap: float = _knob(24.0, "Farthest a silhouette mismatch pulls, in pixels of "
                                   "the full image")
+    limb_search: float = _knob(0.1, "Before refining a frame, turn each limb over a grid of "
+                               "angles against the silhouette and keep the best turn when it "
+                               "beats the prediction by this share of the limb's outline "
+                               "(0: off). Catches limbs faster than a blob's width a frame")
 
     def __post_init__(self):
         for name in ("levels", "iterations", "pixel_step"):
@@ -207,10 +212,14 @@ class Tracker:
             thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
         self.dof_thickness = thin[skeleton.dof_joints_and_axes()[0]]
         self._blob_joints = np.array([b.joint for b in skeleton.blobs], dtype=int)
+        self._dof_joint = skeleton.dof_joints_and_axes()[0]
+        self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
+                         and np.any(np.isfinite(skeleton.limits[j]))]
         self._blob_centres = np.array([b.centre for b in skeleton.blobs])
         self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
         self.notes: list[str] = []  # what the user should know about the run
         self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
+        self._search = LimbSearch(skeleton, self.settings.limb_search)
 
     def _foregrounds(self, frame: int, lv: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
@@ -239,10 +248,6 @@ class Tracker:
             if self._backdrops[c] is None:
                 out.append(None)
                 continue
-            if (c, frame) not in self._fg_cache:
-                self._fg_cache = {k: v for k, v in self._fg_cache.items() if k[1] == frame}
-                self._fg_cache[c, frame] = self._backdrops[c].foreground(
-                    self.seq.grey(c, frame))
             shape = self.seq.pyramid(c, frame)[lv].shape
             boxes = raycast.blob_boxes(est.views[c].at_level(lv), self.skeleton.blobs,
                                        kin.segments)
@@ -250,9 +255,36 @@ class Tracker:
             x0, y0 = np.maximum(np.floor((boxes[:, :2].min(0) - margin) / g), 0).astype(int)
             x1 = int(min(np.ceil((boxes[:, 2].max() + margin) / g), -(-shape[1] // g)))
             y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
-            fg = sil.at_level(self._fg_cache[c, frame], lv)[::g, ::g]
+            fg = sil.at_level(self._foreground(c, frame), lv)[::g, ::g]
             out.append((fg[y0:max(y1, y0), x0:max(x1, x0)], (x0, y0)))
         return out
+
+    def _foreground(self, view: int, frame: int) -> np.ndarray:
+        """Full-resolution 0/1 foreground of ``frame`` in ``view`` (the backdrop is known)."""
+        if (view, frame) not in self._fg_cache:
+            self._fg_cache = {k: v for k, v in self._fg_cache.items() if k[1] == frame}
+            self._fg_cache[view, frame] = self._backdrops[view].foreground(
+                self.seq.grey(view, frame))
+        return self._fg_cache[view, frame]
+
+    def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
+                      ) -> BodyPose:
+        """``est`` with every limb turned to where the silhouette wants it (``LimbSearch``),
+        on the level below full resolution; ``est`` itself when nothing turned."""
+        lv = self._search_level()
+        if self._foregrounds(frame, lv, key, key_frame, est, Kinematics(self.skeleton, est)
+                             ) is None:
+            return est
+        fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
+               for c, b in enumerate(self._backdrops)]
+        if all(f is None for f in fgs):
+            return est
+        searched, turned = self._search.run(est, [v.at_level(lv) for v in est.views], fgs)
+        return searched if turned else est
+
+    def _search_level(self) -> int:
+        """The level the limbs are searched on, after the coarser ones placed the body."""
+        return min(1, self.settings.levels - 1)
 
     def _grid(self, lv: int) -> int:
         """Level pixels between the label map's samples: the fine level is looked at every
@@ -430,6 +462,17 @@ class Tracker:
         cap = np.radians(self.settings.max_step)
         return delta * (cap / turn) if turn > cap else delta
 
+    def _within_limits(self, est: BodyPose, delta: np.ndarray) -> np.ndarray:
+        """The step with every limited hinge's new angle clipped into its range (a hinge
+        found outside it may only move back toward it)."""
+        nr = self.n_params - self.n_dof
+        for k in self._limited:
+            j = self._dof_joint[k]
+            lo, hi = self.skeleton.limits[j]
+            theta = self.skeleton.hinge_angle(j, est.rotations[j])
+            delta[nr + k] = np.clip(theta + delta[nr + k], min(lo, theta), max(hi, theta)) - theta
+        return delta
+
     def _left_views(self, smp: _Samples) -> str:
         """'' while enough of the body is inside every image, else which views it left."""
         gone = np.flatnonzero(smp.inside < self.settings.min_inside)
@@ -484,12 +527,19 @@ class Tracker:
                                                             s.key_weight)
                     sets.append(self._key_sets[k])
             kin = Kinematics(self.skeleton, est)
+            searched = s.limb_search > 0 and lv == self._search_level()
+            if searched:
+                before = est
+                est = self._search_limbs(est, frame, key, key_frame)
+                kin = Kinematics(self.skeleton, est)
             active = self._active(est, lv)
             # a silhouette where some limb cannot move yet would pull the rest in its place
             fgs = (self._foregrounds(frame, lv, key, key_frame, est, kin) if active.all()
                    else None)
             sigmas = self._sigmas(est, kin, sets, levels)
             smp = self._sample(est, kin, sets, levels, lv, sigmas, fgs)
+            if searched and est is not before:
+                offset = np.zeros(self.n_params)  # the prediction from here on (prior's)
             left = self._left_views(smp)
             if left:
                 return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
@@ -500,7 +550,8 @@ class Tracker:
             converged = False
             for _ in range(s.iterations):
                 total_iters += 1
-                delta = self._trust(solve(ne, lam, prior, offset, active))
+                delta = self._within_limits(est, self._trust(solve(ne, lam, prior, offset,
+                                                                    active)))
                 cand = apply_update(self.skeleton, est, delta, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
                 c_smp = self._sample(cand, kin_c, sets, levels, lv, sigmas, fgs)

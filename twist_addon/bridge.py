@@ -8,7 +8,9 @@ C_j = (armature object rotation) @ (bone rest rotation), the two are conjugates:
     R_j = C_j Q_j C_j^T,   Q_j = C_j^T R_j C_j.
 
 A bone whose rotation is locked on exactly two axes is a hinge about the third; one locked on
-all three stays fixed; any other is a ball. A bone's blob runs from its head to its tail with
+all three stays fixed; any other is a ball. A hinge's inverse-kinematics limit on its free axis
+(Bone Properties > Inverse Kinematics) bounds its angle while tracking: the core hinge angle
+is the bone's own rotation about that axis. A bone's blob runs from its head to its tail with
 the mean of its envelope's head and tail radii; a bone whose envelope radii are zero has none.
 """
 
@@ -61,6 +63,7 @@ def skeleton_from_armature(arm) -> Skeleton:
     offsets = np.array([heads[j] - (heads[p] if p >= 0 else 0) for j, p in enumerate(parents)])
     C = bone_frames(arm)
     kinds, axes = [], np.tile([1.0, 0.0, 0.0], (len(bones), 1))
+    limits = np.tile([-np.inf, np.inf], (len(bones), 1))
     for j, pb in enumerate(arm.pose.bones[b.name] for b in bones):
         free = [k for k in range(3) if not pb.lock_rotation[k]]
         if parents[j] < 0 or not free:
@@ -68,9 +71,13 @@ def skeleton_from_armature(arm) -> Skeleton:
         elif len(free) == 1:
             kinds.append(HINGE)
             axes[j] = C[j][:, free[0]]
+            xyz = "xyz"[free[0]]
+            if getattr(pb, f"use_ik_limit_{xyz}"):
+                limits[j] = getattr(pb, f"ik_min_{xyz}"), getattr(pb, f"ik_max_{xyz}")
         else:
             kinds.append(BALL)
-    sk = Skeleton(names=names, parents=parents, offsets=offsets, kinds=kinds, axes=axes)
+    sk = Skeleton(names=names, parents=parents, offsets=offsets, kinds=kinds, axes=axes,
+                  limits=limits)
     _, s = _object_rotation_and_scale(arm)
     sk.blobs = [bone_blob(j, b.name, heads[j], tails[j] - heads[j],
                           s * (b.head_radius + b.tail_radius) / 2)

@@ -98,7 +98,16 @@ def test_locks_choose_hinges_balls_and_fixed_joints(bpy_module, addon):
     assert sk.kinds == ["fixed", "ball", "hinge"]
     C = bridge.bone_frames(arm)
     np.testing.assert_allclose(sk.axes[2], C[2][:, 1])
-    arm.pose.bones["lower"].lock_rotation = (True, True, True)
+    assert np.all(np.isinf(sk.limits[2]))  # no IK limit: free
+    lower = arm.pose.bones["lower"]
+    lower.use_ik_limit_y, lower.ik_min_y, lower.ik_max_y = True, -0.2, 2.5
+    lower.use_ik_limit_x, lower.ik_min_x = True, -1.0  # a locked axis's limit is not the hinge's
+    np.testing.assert_allclose(bridge.skeleton_from_armature(arm).limits[2], [-0.2, 2.5])
+    lower.rotation_mode = "XYZ"
+    lower.rotation_euler = (0, 0.7, 0)
+    R, _ = bridge.pose_from_armature(arm, sk)
+    assert abs(sk.hinge_angle(2, R[2]) - 0.7) < 1e-6  # the angle the limits bound
+    lower.lock_rotation = (True, True, True)
     assert bridge.skeleton_from_armature(arm).kinds[2] == "fixed"
 
 

@@ -106,6 +106,9 @@ def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path, mode):
          "job.json.skeleton.joints.Tail: no such joint"),
         (lambda j: j["skeleton"]["joints"].update(LeftKnee={"kind": "hinge"}),
          "a hinge needs an 'axis'"),
+        (lambda j: j["skeleton"]["joints"].update(
+            LeftKnee={"kind": "hinge", "axis": [1, 0, 0], "limits": [90, 0]}),
+         r"skeleton.joints.LeftKnee.limits: expected \[lowest, highest\] angle in degrees"),
         (lambda j: j["settings"].update(speed=3), "job.json.settings.speed: unknown setting"),
         (lambda j: j["settings"].update(levels="many"), "settings.levels: expected a int"),
         (lambda j: j["views"][0].update(images="nowhere/*.png"),
@@ -171,3 +174,14 @@ def test_a_movie_is_footage_like_its_frames(footage, tmp_path):
     proc = _run("track", path, "--out", out, "--quiet")
     assert proc.returncode == 0, proc.stderr
     assert len(read_bvh(out).motion) == 3
+
+
+def test_hinge_limits_are_read_in_degrees(footage, tmp_path):
+    folder, job = footage
+    limited = json.loads(json.dumps(job))
+    limited["skeleton"]["joints"]["LeftKnee"]["limits"] = [-5, 150]
+    path = folder / "job_limited.json"
+    path.write_text(json.dumps(limited))
+    sk = load_job(path).skeleton
+    np.testing.assert_allclose(np.degrees(sk.limits[sk.index("LeftKnee")]), [-5, 150])
+    assert np.all(np.isinf(sk.limits[sk.index("RightKnee")]))  # none given: free

@@ -189,3 +189,19 @@ def test_a_planar_chain_seen_from_the_side_is_tracked_in_one_view():
     # image of the chain is determined, and it is what is compared
     assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 15
     assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 0.5
+
+
+def test_a_hinge_is_held_within_its_limits(body):
+    """The footage bends the left knee 25 degrees; a knee limited to 10 stops there."""
+    _, pose = body
+    sk = human_template()  # a skeleton of its own: the test sets a limit on it
+    j = sk.index("LeftKnee")
+    bent = pose.copy()
+    bent.rotations[j] = se3.exp_so3(sk.axes[j] * np.radians(25))
+    frames = [[render(sk, p, c, noise=0.005, seed=i) for i, p in enumerate((pose, bent))]
+              for c in range(3)]
+    free = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1]).frames[1].pose
+    assert abs(np.degrees(sk.hinge_angle(j, free.rotations[j])) - 25) < 2
+    sk.limits[j] = np.radians([-10, 10])
+    held = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1]).frames[1].pose
+    assert 5 < np.degrees(sk.hinge_angle(j, held.rotations[j])) <= 10 + 1e-9

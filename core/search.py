@@ -1,0 +1,251 @@
+"""A coarse search of each limb against the silhouette, before Gauss-Newton refines the pose.
+
+Brightness and the chamfer pulls both follow the nearest minimum; a shank that swings 45
+degrees between two frames of 15 fps footage is past it. Here each tracked joint, parents
+first, is turned over a grid of angles from the current pose and every turn is scored in
+all views at once by the outline of the joint's own segment (its blobs that no tracked joint
+below it moves) against the foreground: a covered background pixel costs 1, a foreground
+pixel that the rest of the body leaves uncovered pays back ``UNCOVERED_GAIN`` (pixels the
+rest covers count for nothing, so a limb in front of the trunk scores the same anywhere over
+it and stays). A ball joint is turned in the two swings across its bone. A hinge below a
+ball is turned about its axis and, with it, the ball's twist about its bone, which decides
+the plane the hinge swings in and which no outline of the upper segment shows. The best
+turn is refined on a finer grid and kept when it beats the current pose by ``margin`` times
+the segment's outline area. Outlines are unions of projected ellipses
+(``raycast.shadows``), so the search needs no depth order. Grids in degrees; pixels on one
+pyramid level.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import se3
+from .camera import View
+from .linearize import Kinematics
+from .pose import BodyPose
+from .raycast import blob_frames, shadows
+from .skeleton import BALL, HINGE, Skeleton
+
+SWING = (np.arange(-60, 61, 15), np.arange(-10, 11, 5))  # coarse grid, then around the best
+HINGE_TURN = (np.arange(-90, 91, 10), np.arange(-6, 7, 3))
+TWIST = (np.arange(-45, 46, 15), np.arange(-10, 11, 5))
+# what a newly covered foreground pixel pays back: at the chamfer's 0.3, a foreground with
+# holes (a body close to its backdrop's brightness) made hiding a limb behind the trunk pay
+UNCOVERED_GAIN = 0.6
+SIDE_ON = np.cos(np.radians(25))  # a hinge axis this close to one view's direction turns
+MIN_FOREGROUND = 0.7  # share of the body's outline that must be foreground to search a view
+
+
+@dataclass
+class _Limb:
+    joint: int
+    own: np.ndarray  # blobs scored: the joint's own segment
+    below: np.ndarray  # every blob the joint moves (left out of the rest of the body)
+    dofs: list  # (joint, local axis, (coarse grid, fine grid)), parents first
+
+
+def _outlines(view: View, A: np.ndarray, C: np.ndarray):
+    """Each ellipsoid's outline as row spans: centres c (..., 2), row range (..., 2) and the
+    forms P (..., 2, 2) of ``raycast.shadows``."""
+    c, P = shadows(view, A, C)
+    det = np.linalg.det(P)
+    half = np.sqrt(np.stack([P[..., 1, 1], P[..., 0, 0]], -1) / det[..., None])
+    return c, half, P
+
+
+def _box(c: np.ndarray, half: np.ndarray, shape) -> tuple | None:
+    """Pixels (x0, y0, x1, y1) of ``shape`` holding every outline given."""
+    lo = np.floor((c - half).reshape(-1, 2).min(0)).astype(int)
+    hi = np.ceil((c + half).reshape(-1, 2).max(0)).astype(int) + 1
+    x0, y0 = max(lo[0], 0), max(lo[1], 0)
+    x1, y1 = min(hi[0], shape[1]), min(hi[1], shape[0])
+    return None if x0 >= x1 or y0 >= y1 else (x0, y0, x1, y1)
+
+
+def _inside(box: tuple, outer: tuple) -> bool:
+    return (box[0] >= outer[0] and box[1] >= outer[1] and box[2] <= outer[2]
+            and box[3] <= outer[3])
+
+
+def _spans(c, half, P, box):
+    """Per ellipse and box row: the first and one-past-last box column it covers (start ==
+    stop where it covers none). Shapes (..., rows)."""
+    x0, y0, x1, y1 = box
+    dy = np.arange(y0, y1, dtype=float) - c[..., 1:]  # (..., rows)
+    a, b = P[..., 0, 0, None], P[..., 0, 1, None] * dy
+    disc = b * b - a * (P[..., 1, 1, None] * dy * dy - 1)
+    root = np.sqrt(np.maximum(disc, 0))
+    lo = np.ceil(c[..., :1] + (-b - root) / a) - x0
+    hi = np.floor(c[..., :1] + (-b + root) / a) - x0 + 1
+    lo, hi = np.clip(lo, 0, x1 - x0), np.clip(hi, 0, x1 - x0)
+    hi = np.where(disc > 0, np.maximum(hi, lo), lo)
+    return lo.astype(int), hi.astype(int)
+
+
+def _paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tuple) -> None:
+    """Set the pixels of ``mask`` (the box's size) that any ellipsoid's outline covers."""
+    c, half, P = _outlines(view, A, C)
+    lo, hi = _spans(c, half, P, box)
+    cols = np.arange(mask.shape[1])
+    for e in range(len(A)):
+        rows = np.flatnonzero(hi[e] > lo[e])
+        if len(rows):
+            mask[rows] |= (cols >= lo[e, rows, None]) & (cols < hi[e, rows, None])
+
+
+def _sums(c, half, P, box, S: np.ndarray) -> np.ndarray:
+    """Per candidate (K, B blobs each): the sum over its outline (the union of its blobs'
+    ellipses) of the box image whose row prefix sums are S (rows, cols + 1). Overlaps of two
+    ellipses are taken out once; a pixel under three of one candidate's is counted twice."""
+    lo, hi = _spans(c, half, P, box)  # (K, B, rows)
+    rows = np.arange(S.shape[0])
+    total = np.sum(S[rows, hi] - S[rows, lo], axis=(1, 2))
+    for i, k in itertools.combinations(range(lo.shape[1]), 2):
+        a, b = np.maximum(lo[:, i], lo[:, k]), np.minimum(hi[:, i], hi[:, k])
+        total -= np.sum(np.where(b > a, S[rows, np.maximum(a, b)] - S[rows, a], 0), axis=1)
+    return total
+
+
+class LimbSearch:
+    """Searches the limbs of ``skeleton`` against per-view foregrounds on one level."""
+
+    def __init__(self, skeleton: Skeleton, margin: float):
+        self.sk = skeleton
+        self.margin = margin
+        moved = skeleton.moved_by()  # [m, j]: j moves m
+        blob_joint = np.array([b.joint for b in skeleton.blobs], dtype=int)
+        tracked = [j for j in range(1, skeleton.n_joints) if skeleton.kinds[j] in (BALL, HINGE)]
+        self.limbs: list[_Limb] = []
+        for j in tracked:
+            below = moved[blob_joint, j]
+            inner = [k for k in tracked if k != j and moved[k, j]]
+            own = below & ~np.any(moved[blob_joint][:, inner], axis=1)
+            if not own.any():
+                continue
+            frame = skeleton.bone_frame(j)
+            if skeleton.kinds[j] == BALL:
+                dofs = [(j, frame[1], SWING), (j, frame[2], SWING)]
+            else:
+                dofs = [(j, np.asarray(skeleton.axes[j], float), HINGE_TURN)]
+                p = skeleton.parents[j]
+                if skeleton.kinds[p] == BALL:
+                    dofs.insert(0, (p, skeleton.bone_frame(p)[0], TWIST))
+            self.limbs.append(_Limb(j, np.flatnonzero(own), np.flatnonzero(below), dofs))
+
+    def run(self, pose: BodyPose, views: Sequence[View], fgs: Sequence[np.ndarray | None]
+            ) -> tuple[BodyPose, list[str]]:
+        """The pose with each limb turned to its best place, and the joints that turned.
+        ``views`` and ``fgs`` (boolean masks; None for a view without one) share one level; a
+        view where under ``MIN_FOREGROUND`` of the body's outline is foreground is left out.
+        With one view left, only hinges whose axis points along that view turn (a limb seen
+        side-on, an animal's): any other turn moves the limb in depth too, and one outline
+        cannot tell a limb turned toward the camera from a shorter one."""
+        pose = pose.copy()
+        kin = Kinematics(self.sk, pose)
+        A, C = blob_frames(self.sk.blobs, kin.segments)
+        fgs = [None if fg is None or self._foreground_share(view, fg, A, C) < MIN_FOREGROUND
+               else fg for view, fg in zip(views, fgs)]
+        n_views = sum(fg is not None for fg in fgs)
+        turned = []
+        for limb in self.limbs:
+            if n_views == 0:
+                break
+            kin = Kinematics(self.sk, pose)
+            if n_views == 1:
+                view = next(v for v, fg in zip(views, fgs) if fg is not None)
+                j, axis, _ = limb.dofs[-1]
+                if (self.sk.kinds[j] != HINGE or abs(view.pose.R[2] @ kin.frames[j, :3, :3]
+                                                      @ axis) < SIDE_ON):
+                    continue
+                limb = _Limb(limb.joint, limb.own, limb.below, limb.dofs[-1:])
+            A, C = blob_frames(self.sk.blobs, kin.segments)
+            rest = np.setdiff1d(np.arange(len(self.sk.blobs)), limb.below)
+            angles = self._best(limb, kin, A, C, rest, views, fgs)
+            if angles is not None:
+                for (j, axis, _), a in zip(limb.dofs, angles):
+                    pose.rotations[j] = pose.rotations[j] @ se3.exp_so3(axis * np.radians(a))
+                turned.append(self.sk.names[limb.joint])
+        return pose, turned
+
+    @staticmethod
+    def _foreground_share(view: View, fg: np.ndarray, A, C) -> float:
+        """How much of the body's outline is foreground: low when the body's brightness is
+        close to its backdrop's (then holes in a limb's outline would make hiding it pay) or
+        when the body as a whole is far off."""
+        body = np.zeros(fg.shape, bool)
+        _paint(body, view, A, C, (0, 0, fg.shape[1], fg.shape[0]))
+        return float(fg[body].mean()) if body.any() else 0.0
+
+    @staticmethod
+    def _gain_sums(view: View, fg: np.ndarray, A, C, box) -> np.ndarray:
+        """Row prefix sums (rows, cols + 1) over ``box`` of what covering each pixel costs:
+        nothing where the ellipsoids A, C (the rest of the body) cover it, else 1 on the
+        background and -``UNCOVERED_GAIN`` on the foreground."""
+        x0, y0, x1, y1 = box
+        others = np.zeros((y1 - y0, x1 - x0), bool)
+        _paint(others, view, A, C, box)
+        gain = np.where(others, 0.0, np.where(fg[y0:y1, x0:x1], -UNCOVERED_GAIN, 1.0))
+        S = np.zeros((gain.shape[0], gain.shape[1] + 1))
+        np.cumsum(gain, axis=1, out=S[:, 1:])
+        return S
+
+    def _allowed(self, limb: _Limb, pose: BodyPose, cands: np.ndarray) -> np.ndarray:
+        """Which candidates keep every limited hinge within its range (or no farther out of
+        it than it is); the current pose, all zeros, always."""
+        ok = np.ones(len(cands), bool)
+        for i, (j, _, _) in enumerate(limb.dofs):
+            if self.sk.kinds[j] == HINGE:
+                lo, hi = np.degrees(self.sk.limits[j])
+                theta = np.degrees(self.sk.hinge_angle(j, pose.rotations[j]))
+                new = theta + cands[:, i]
+                ok &= (new >= min(lo, theta)) & (new <= max(hi, theta))
+        return ok
+
+    def _best(self, limb: _Limb, kin: Kinematics, A, C, rest, views, fgs
+              ) -> np.ndarray | None:
+        """The limb's best angles (degrees, one per dof) if they beat the current pose; A, C
+        are every blob's (``blob_frames``), ``rest`` the blobs that stay."""
+        pivot = kin.frames[limb.joint, :3, 3]
+        best = np.zeros(len(limb.dofs))
+        sums = {}  # per view: a box and its gains' row prefix sums, kept while they hold
+        for stage in (0, 1):
+            grids = [best[i] + g[stage] for i, (_, _, g) in enumerate(limb.dofs)]
+            cands = np.array(list(itertools.product(*grids)))
+            if stage == 0:
+                cands = np.vstack([np.zeros(len(limb.dofs)), cands])  # the current pose first
+            cands = cands[self._allowed(limb, kin.pose, cands)]
+            Rw = np.broadcast_to(np.eye(3), (len(cands), 3, 3))
+            for i, (j, axis, _) in enumerate(limb.dofs):  # parents first: a world rotation each
+                W = kin.frames[j, :3, :3]
+                Rw = Rw @ se3.exp_so3(np.radians(cands[:, i, None]) * (W @ axis))
+            Ck = np.einsum("kab,eb->kea", Rw, C[limb.own] - pivot) + pivot
+            Ak = np.einsum("eab,kcb->keac", A[limb.own], Rw)
+            cost = np.zeros(len(cands))
+            if stage == 0:
+                area = 0.0
+            for v, (view, fg) in enumerate(zip(views, fgs)):
+                if fg is None:
+                    continue
+                c, half, P = _outlines(view, Ak, Ck)
+                box = _box(c, half, fg.shape)
+                if box is None:
+                    continue
+                if v not in sums or not _inside(box, sums[v][0]):
+                    sums[v] = box, self._gain_sums(view, fg, A[rest], C[rest], box)
+                box, S = sums[v]
+                cost += _sums(c, half, P, box, S)
+                if stage == 0:
+                    ones = np.zeros_like(S)
+                    ones[:, 1:] = np.arange(1, S.shape[1])
+                    area += float(_sums(c[:1], half[:1], P[:1], box, ones)[0])
+            if stage == 0:
+                current = cost[0]
+            best = cands[int(np.argmin(cost))]
+        if np.min(cost) < current - self.margin * area and np.any(best):
+            return best
+        return None

@@ -1,0 +1,126 @@
+"""The limb search: projected outlines against per-pixel ray casting, outline sums against
+brute force, and limbs turned far past brightness's reach found again from their outline."""
+
+import numpy as np
+
+from core import raycast, se3
+from core.linearize import Kinematics
+from core.pose import INDEPENDENT, BodyPose, apply_update
+from core.search import LimbSearch, _outlines, _paint, _sums
+from core.skeleton import human_template
+from support.synthetic import side_view
+
+BODY = (360, 320)  # image size
+
+
+def _covered_by_casting(view, sk, g, shape):
+    """Brute force: a pixel is covered when its ray hits any blob."""
+    ys, xs = np.mgrid[: shape[0], : shape[1]]
+    pix = np.stack([xs.ravel(), ys.ravel()], 1).astype(float)
+    return (raycast.cast(view, pix, sk.blobs, g).label >= 0).reshape(shape)
+
+
+def _rest(sk):
+    return BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                    [side_view(yaw_deg=y) for y in (90, 30)])
+
+
+def test_outlines_cover_exactly_the_pixels_whose_rays_hit_a_blob():
+    sk = human_template()
+    rng = np.random.default_rng(3)
+    turns = np.concatenate([np.zeros(12), rng.normal(0, 0.4, len(sk.dof_names()))])
+    pose = apply_update(sk, _rest(sk), turns, INDEPENDENT)
+    g = Kinematics(sk, pose).segments
+    A, C = raycast.blob_frames(sk.blobs, g)
+    for view in pose.views:
+        painted = np.zeros(BODY, bool)
+        _paint(painted, view, A, C, (0, 0, BODY[1], BODY[0]))
+        cast = _covered_by_casting(view, sk, g, BODY)
+        assert cast.sum() > 5000
+        assert np.sum(painted != cast) <= 2, np.sum(painted != cast)  # round-off on the rim
+
+
+def test_outline_sums_count_each_pixel_of_overlapping_blobs_once():
+    sk = human_template()
+    pose = _rest(sk)
+    g = Kinematics(sk, pose).segments
+    A, C = raycast.blob_frames(sk.blobs, g)
+    thigh, shank = (next(i for i, b in enumerate(sk.blobs) if b.joint == sk.index(n))
+                    for n in ("LeftHip", "LeftKnee"))
+    A = np.vstack([A, A[thigh][None] * [[0.8], [1], [1]]])  # a thigh 25 % longer, both ways
+    C = np.vstack([C, C[thigh][None]])
+    img = np.random.default_rng(0).normal(size=BODY)
+    S = np.zeros((BODY[0], BODY[1] + 1))
+    np.cumsum(img, 1, out=S[:, 1:])
+    box = (0, 0, BODY[1], BODY[0])
+    for view in pose.views:
+        for pair in ([thigh, -1], [shank, -1]):
+            c, half, P = _outlines(view, A[None, pair], C[None, pair])
+            union = np.zeros(BODY, bool)
+            _paint(union, view, A[pair], C[pair], box)
+            one, other = np.zeros(BODY, bool), np.zeros(BODY, bool)
+            _paint(one, view, A[pair[:1]], C[pair[:1]], box)
+            _paint(other, view, A[pair[1:]], C[pair[1:]], box)
+            assert union.sum() < one.sum() + other.sum()  # they overlap
+            np.testing.assert_allclose(_sums(c, half, P, box, S)[0], img[union].sum(),
+                                       atol=1e-9)
+
+
+def _foreground(sk, pose, view):
+    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, pose).segments)
+    fg = np.zeros(BODY, bool)
+    _paint(fg, view, A, C, (0, 0, BODY[1], BODY[0]))
+    return fg
+
+
+def _turned(sk, pose, turns):
+    """``pose`` with joints turned by {name: rotation vector (degrees) in the joint's frame}."""
+    out = pose.copy()
+    for name, w in turns.items():
+        j = sk.index(name)
+        out.rotations[j] = out.rotations[j] @ se3.exp_so3(np.radians(w))
+    return out
+
+
+def _limb_error(sk, a, b, joint):
+    """Angle (degrees) between the world directions of the bone below ``joint``."""
+    j = sk.index(joint)
+    bone = sk.bone_frame(j)[0]
+    Ma = sk.joint_frames(a.rotations, a.root_position)[j, :3, :3]
+    Mb = sk.joint_frames(b.rotations, b.root_position)[j, :3, :3]
+    return float(np.degrees(se3.angle_between_vectors(Ma @ bone, Mb @ bone)))
+
+
+def _hinge(sk, name, degrees):
+    return {name: sk.axes[sk.index(name)] * degrees}
+
+
+def test_limbs_turned_far_are_found_from_the_outline():
+    sk = human_template()
+    pose = _rest(sk)
+    turns = {**_hinge(sk, "LeftKnee", 70), **_hinge(sk, "RightElbow", -80),
+             "RightHip": sk.bone_frame(sk.index("RightHip"))[1] * 40}
+    truth = _turned(sk, pose, turns)
+    fgs = [_foreground(sk, truth, v) for v in pose.views]
+    moved = ["LeftKnee", "RightElbow", "RightHip"]
+    assert min(_limb_error(sk, pose, truth, j) for j in moved) > 35  # far past a blob's width
+    found, turned = LimbSearch(sk, margin=0.1).run(pose, pose.views, fgs)
+    assert set(turned) == set(moved)
+    for j in moved:
+        assert _limb_error(sk, found, truth, j) < 4.0, j
+    # a view whose foreground is mostly holes (a body the brightness of its backdrop) is not
+    # searched: hiding a limb would pay there
+    rng = np.random.default_rng(0)
+    holey = [fg & (rng.random(BODY) < 0.5) for fg in fgs]
+    assert LimbSearch(sk, margin=0.1).run(pose, pose.views, holey)[1] == []
+
+
+def test_a_limb_is_not_turned_past_its_limits():
+    sk = human_template()
+    j = sk.index("LeftKnee")
+    sk.limits[j] = np.radians([-10, 50])
+    pose = _rest(sk)
+    truth = _turned(sk, pose, _hinge(sk, "LeftKnee", 70))
+    found, _ = LimbSearch(sk, margin=0.1).run(
+        pose, pose.views, [_foreground(sk, truth, v) for v in pose.views])
+    assert 40 <= np.degrees(sk.hinge_angle(j, found.rotations[j])) <= 50 + 1e-9
