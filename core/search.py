@@ -152,9 +152,7 @@ class LimbSearch:
                else fg for view, fg in zip(views, fgs)]
         n_views = sum(fg is not None for fg in fgs)
         turned = []
-        for limb in self.limbs:
-            if n_views == 0:
-                break
+        for limb in self.limbs if n_views else ():
             kin = Kinematics(self.sk, pose)
             if n_views == 1:
                 view = next(v for v, fg in zip(views, fgs) if fg is not None)

@@ -210,9 +210,9 @@ class Tracker:
         thin = np.full(skeleton.n_joints, np.inf)
         for b in skeleton.blobs:
             thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
-        self.dof_thickness = thin[skeleton.dof_joints_and_axes()[0]]
-        self._blob_joints = np.array([b.joint for b in skeleton.blobs], dtype=int)
         self._dof_joint = skeleton.dof_joints_and_axes()[0]
+        self.dof_thickness = thin[self._dof_joint]
+        self._blob_joints = np.array([b.joint for b in skeleton.blobs], dtype=int)
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
         self._blob_centres = np.array([b.centre for b in skeleton.blobs])
@@ -224,23 +224,11 @@ class Tracker:
     def _foregrounds(self, frame: int, lv: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
         """Per view, the foreground of ``frame`` on level ``lv`` around the body at ``est``
-        (None when the term is off): (boolean crop, its top-left level pixel). Backdrops are
-        learned from the key frame the first time they are needed."""
+        (None when the term is off): (boolean crop, its top-left level pixel)."""
         s = self.settings
         if s.silhouette <= 0:
             return None
-        if self._backdrops is None:
-            kin_key = Kinematics(self.skeleton, key)
-            self._backdrops = []
-            others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
-            for c in range(self.seq.n_views):
-                grey = self.seq.grey(c, key_frame)
-                backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
-                    self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})])
-                if not backdrop.still:
-                    self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
-                                      "frame (a moving camera?), so its silhouette is not used")
-                self._backdrops.append(backdrop if backdrop.still else None)
+        self._learn_first_backdrops(key, key_frame)
         out = []
         g = self._grid(lv)
         margin = s.silhouette_cap / 2**lv + 2 * g
@@ -259,6 +247,23 @@ class Tracker:
             out.append((fg[y0:max(y1, y0), x0:max(x1, x0)], (x0, y0)))
         return out
 
+    def _learn_first_backdrops(self, key: BodyPose, key_frame: int) -> None:
+        """Each view's backdrop from the key frame, the first time one is needed (None for a
+        view whose backdrop moves, with a note saying so)."""
+        if self._backdrops is not None:
+            return
+        kin_key = Kinematics(self.skeleton, key)
+        self._backdrops = []
+        others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
+        for c in range(self.seq.n_views):
+            grey = self.seq.grey(c, key_frame)
+            backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
+                self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})])
+            if not backdrop.still:
+                self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
+                                  "frame (a moving camera?), so its silhouette is not used")
+            self._backdrops.append(backdrop if backdrop.still else None)
+
     def _foreground(self, view: int, frame: int) -> np.ndarray:
         """Full-resolution 0/1 foreground of ``frame`` in ``view`` (the backdrop is known)."""
         if (view, frame) not in self._fg_cache:
@@ -271,10 +276,10 @@ class Tracker:
                       ) -> BodyPose:
         """``est`` with every limb turned to where the silhouette wants it (``LimbSearch``),
         on the level below full resolution; ``est`` itself when nothing turned."""
-        lv = self._search_level()
-        if self._foregrounds(frame, lv, key, key_frame, est, Kinematics(self.skeleton, est)
-                             ) is None:
+        if self.settings.silhouette <= 0:
             return est
+        self._learn_first_backdrops(key, key_frame)
+        lv = self._search_level()
         fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
                for c, b in enumerate(self._backdrops)]
         if all(f is None for f in fgs):
@@ -527,19 +532,17 @@ class Tracker:
                                                             s.key_weight)
                     sets.append(self._key_sets[k])
             kin = Kinematics(self.skeleton, est)
-            searched = s.limb_search > 0 and lv == self._search_level()
-            if searched:
-                before = est
-                est = self._search_limbs(est, frame, key, key_frame)
-                kin = Kinematics(self.skeleton, est)
+            if s.limb_search > 0 and lv == self._search_level():
+                searched = self._search_limbs(est, frame, key, key_frame)
+                if searched is not est:  # the prediction from here on (what prior holds to)
+                    est, offset = searched, np.zeros(self.n_params)
+                    kin = Kinematics(self.skeleton, est)
             active = self._active(est, lv)
             # a silhouette where some limb cannot move yet would pull the rest in its place
             fgs = (self._foregrounds(frame, lv, key, key_frame, est, kin) if active.all()
                    else None)
             sigmas = self._sigmas(est, kin, sets, levels)
             smp = self._sample(est, kin, sets, levels, lv, sigmas, fgs)
-            if searched and est is not before:
-                offset = np.zeros(self.n_params)  # the prediction from here on (prior's)
             left = self._left_views(smp)
             if left:
                 return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
