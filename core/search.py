@@ -153,7 +153,6 @@ class LimbSearch:
         n_views = sum(fg is not None for fg in fgs)
         turned = []
         for limb in self.limbs if n_views else ():
-            kin = Kinematics(self.sk, pose)
             if n_views == 1:
                 view = next(v for v, fg in zip(views, fgs) if fg is not None)
                 j, axis, _ = limb.dofs[-1]
@@ -161,13 +160,14 @@ class LimbSearch:
                                                       @ axis) < SIDE_ON):
                     continue
                 limb = _Limb(limb.joint, limb.own, limb.below, limb.dofs[-1:])
-            A, C = blob_frames(self.sk.blobs, kin.segments)
             rest = np.setdiff1d(np.arange(len(self.sk.blobs)), limb.below)
             angles = self._best(limb, kin, A, C, rest, views, fgs)
             if angles is not None:
                 for (j, axis, _), a in zip(limb.dofs, angles):
                     pose.rotations[j] = pose.rotations[j] @ se3.exp_so3(axis * np.radians(a))
                 turned.append(self.sk.names[limb.joint])
+                kin = Kinematics(self.sk, pose)  # the limbs below see it turned
+                A, C = blob_frames(self.sk.blobs, kin.segments)
         return pose, turned
 
     @staticmethod
@@ -198,10 +198,8 @@ class LimbSearch:
         ok = np.ones(len(cands), bool)
         for i, (j, _, _) in enumerate(limb.dofs):
             if self.sk.kinds[j] == HINGE:
-                lo, hi = np.degrees(self.sk.limits[j])
-                theta = np.degrees(self.sk.hinge_angle(j, pose.rotations[j]))
-                new = theta + cands[:, i]
-                ok &= (new >= min(lo, theta)) & (new <= max(hi, theta))
+                lo, hi = np.degrees(self.sk.hinge_turns(j, pose.rotations[j]))
+                ok &= (cands[:, i] >= lo) & (cands[:, i] <= hi)
         return ok
 
     def _best(self, limb: _Limb, kin: Kinematics, A, C, rest, views, fgs

@@ -145,6 +145,13 @@ class Skeleton:
         0 at the BVH's rest pose), the quantity ``limits`` bound."""
         return float(se3.log_so3(rotation) @ self.axes[j])
 
+    def hinge_turns(self, j: int, rotation: np.ndarray) -> tuple[float, float]:
+        """The turns (radians, from ``rotation``) that hinge j may make: those that end
+        within its limits, or no farther out of them than it already is."""
+        theta = self.hinge_angle(j, rotation)
+        lo, hi = self.limits[j]
+        return min(lo, theta) - theta, max(hi, theta) - theta
+
     def dof_names(self) -> list[str]:
         names = []
         for j, kind in enumerate(self.kinds):

@@ -473,9 +473,7 @@ class Tracker:
         nr = self.n_params - self.n_dof
         for k in self._limited:
             j = self._dof_joint[k]
-            lo, hi = self.skeleton.limits[j]
-            theta = self.skeleton.hinge_angle(j, est.rotations[j])
-            delta[nr + k] = np.clip(theta + delta[nr + k], min(lo, theta), max(hi, theta)) - theta
+            delta[nr + k] = np.clip(delta[nr + k], *self.skeleton.hinge_turns(j, est.rotations[j]))
         return delta
 
     def _left_views(self, smp: _Samples) -> str:
