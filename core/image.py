@@ -91,10 +91,10 @@ def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros((0, 3), np.float32), inside
     cols = min(N, _REMAP_COLS)
     rows = -(-N // cols)
-    pad = rows * cols - N
-    mx = np.pad(p[:, 0], (0, pad)).reshape(rows, cols)
-    my = np.pad(p[:, 1], (0, pad)).reshape(rows, cols)
-    vals = cv2.remap(level.stack, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    maps = np.zeros((rows * cols, 2), np.float32)  # remap takes a 2-D map; pad the tail
+    maps[:N] = p
+    vals = cv2.remap(level.stack, maps.reshape(rows, cols, 2), None, cv2.INTER_LINEAR,
+                     borderMode=cv2.BORDER_REPLICATE)
     vals = vals.reshape(-1, 3)[:N].copy()
     vals[:, 1:] /= level.scale
     return vals, inside

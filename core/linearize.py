@@ -50,6 +50,12 @@ def _cross_g(q: np.ndarray, grad: np.ndarray) -> np.ndarray:
     return np.stack([-q[:, 2] * gy, q[:, 2] * gx, q[:, 0] * gy - q[:, 1] * gx], 1)
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise a x b for (N, 3) arrays (np.cross costs more than the product on few rows)."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], 1)
+
+
 def rows(
     kin: Kinematics,
     view_index: int,
@@ -66,23 +72,21 @@ def rows(
     D = len(kin.dof_joint)
     N = len(q)
     A = np.zeros((N, nr + D))
-    root_c = view.scaled(kin.frames[0, :3, 3])
-    qxg = _cross_g(q, grad)
+    d = q - view.scaled(kin.frames[0, :3, 3])  # from the root, scaled camera frame
+    dxg = _cross_g(d, grad)
     if mode == CALIBRATED:
-        Rt, s = view.pose.R.T, view.pose.s
-        g3 = np.concatenate([grad, np.zeros((N, 1))], 1)
-        A[:, 0:3] = s * g3 @ Rt.T
-        A[:, 3:6] = (qxg - np.cross(root_c, g3)) @ Rt.T
+        R = view.pose.R
+        A[:, 0:3] = view.pose.s * grad @ R[:2]
+        A[:, 3:6] = dxg @ R
     else:
-        d = q - root_c
         o = ROOT_PARAMS * view_index
         A[:, o] = grad[:, 0] * d[:, 0] + grad[:, 1] * d[:, 1]
         A[:, o + 1 : o + 3] = grad
-        A[:, o + 3 : o + 6] = _cross_g(d, grad)
+        A[:, o + 3 : o + 6] = dxg
     if D:
         w_cam = kin.dof_axis_world @ view.pose.R.T  # (D, 3)
         o_cam = view.scaled(kin.dof_point_world)  # (D, 3)
-        v_cam = np.cross(o_cam, w_cam)
-        J = grad @ v_cam[:, :2].T + qxg @ w_cam.T
+        v_cam = _cross(o_cam, w_cam)
+        J = grad @ v_cam[:, :2].T + _cross_g(q, grad) @ w_cam.T
         A[:, nr:] = J * kin.moves[seg_joint]
     return A

@@ -108,7 +108,6 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     ys = np.arange(y0, y1, step, dtype=float)
     depth = np.full((len(ys), len(xs)), np.inf)
     label = np.full(depth.shape, -1)
-    rim = np.zeros(depth.shape)
     A, C = blob_frames(blobs, g)
     o00, d = view.ray(np.array([[0.0, 0.0]]))
     ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
@@ -128,30 +127,38 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     cxx, cxy, cyy = dot(wx, wx), dot(wx, wy), dot(wy, wy)
     d00, dx, dy = b0 * b0 - a * c00, 2 * (b0 * bx - a * c0x), 2 * (b0 * by - a * c0y)
     dxx, dxy, dyy = bx * bx - a * cxx, 2 * (bx * by - a * cxy), by * by - a * cyy
-    for i in range(len(blobs)):
-        bb = _clip_box(boxes[i, :2], boxes[i, 2:], shape, 1)
-        if bb is None:
+    # each blob's grid columns and rows: its box widened by a pixel, clipped to the image
+    H, W = shape
+    lo = np.maximum(np.floor(boxes[:, :2]) - 1, 0)
+    hi = np.minimum(np.ceil(boxes[:, 2:]) + 2, [W, H])
+    first = np.maximum(-((np.array([x0, y0]) - lo) // step), 0).astype(int)
+    stop = np.minimum(np.maximum(-((np.array([x0, y0]) - hi) // step), 0),
+                      [len(xs), len(ys)]).astype(int)
+    disc_front = np.zeros(depth.shape)  # the front blob's discriminant, for the rim
+    coeffs = zip(*(c.tolist() for c in (d00, dx, dy, dxx, dxy, dyy, b0, bx, by, a)))
+    for i, ((c0, r0), (c1, r1), (k00, kx, ky, kxx, kxy, kyy, k0, kbx, kby, ka)) in enumerate(
+            zip(first.tolist(), stop.tolist(), coeffs)):
+        if c0 >= c1 or r0 >= r1:
             continue
-        cx = slice(max(0, -(-(bb[0] - x0) // step)), max(0, -(-(bb[2] - x0) // step)))
-        cy = slice(max(0, -(-(bb[1] - y0) // step)), max(0, -(-(bb[3] - y0) // step)))
-        u, v = xs[cx], ys[cy]
-        if not len(u) or not len(v):
-            continue
-        du = (dxx[i] * u + dx[i]) * u
-        dv = (dyy[i] * v + dy[i]) * v + d00[i]
-        disc = du[None, :] + dv[:, None] + dxy[i] * np.outer(v, u)
-        bq = (b0[i] + by[i] * v)[:, None] + bx[i] * u[None, :]
-        lam = (-bq - np.sqrt(np.maximum(disc, 0))) / a[i]
-        D = depth[cy, cx]
+        u, v = xs[c0:c1], ys[r0:r1]
+        disc = np.add.outer((kyy * v + ky) * v + k00, (kxx * u + kx) * u)
+        cross = np.outer(v, u)
+        cross *= kxy
+        disc += cross
+        lam = np.sqrt(np.maximum(disc, 0))
+        lam += np.add.outer(k0 + kby * v, kbx * u)
+        lam /= -ka
+        D = depth[r0:r1, c0:c1]
         nearer = (disc > 0) & (lam < D)
         np.copyto(D, lam, where=nearer)
-        np.copyto(label[cy, cx], i, where=nearer)
-        np.copyto(rim[cy, cx], np.minimum(disc / a[i], 1.0), where=nearer)
+        np.copyto(label[r0:r1, c0:c1], i, where=nearer)
+        np.copyto(disc_front[r0:r1, c0:c1], disc, where=nearer)
     vv, uu = np.nonzero(label >= 0)
     pixels = np.stack([xs[uu], ys[vv]], 1)
     dep = depth[vv, uu]
+    lab = label[vv, uu]
     origin = o00[0] + pixels[:, :1] * ox + pixels[:, 1:] * oy
-    hits = Hits(label[vv, uu], dep, origin + dep[:, None] * d, rim[vv, uu])
+    hits = Hits(lab, dep, origin + dep[:, None] * d, np.minimum(disc_front[vv, uu] / a[lab], 1.0))
     return pixels, hits, box
 
 
