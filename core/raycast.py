@@ -134,20 +134,20 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     first = np.maximum(-((np.array([x0, y0]) - lo) // step), 0).astype(int)
     stop = np.minimum(np.maximum(-((np.array([x0, y0]) - hi) // step), 0),
                       [len(xs), len(ys)]).astype(int)
-    disc_front = np.zeros(depth.shape)  # the front blob's discriminant, for the rim
-    coeffs = zip(*(c.tolist() for c in (d00, dx, dy, dxx, dxy, dyy, b0, bx, by, a)))
-    for i, ((c0, r0), (c1, r1), (k00, kx, ky, kxx, kxy, kyy, k0, kbx, kby, ka)) in enumerate(
-            zip(first.tolist(), stop.tolist(), coeffs)):
+    # over the whole grid at once, per blob, divided by a^2 (so that sqrt(disc) / a is one
+    # root) and by -a: disc / a^2 = DV(v) + DU(u) + v KUV(u), depth = BV(v) + BU(u) - sqrt
+    a2 = (a * a)[:, None]
+    DU, KUV = (dxx[:, None] * xs + dx[:, None]) * xs / a2, dxy[:, None] * xs / a2
+    DV = ((dyy[:, None] * ys + dy[:, None]) * ys + d00[:, None]) / a2
+    BU, BV = -bx[:, None] * xs / a[:, None], -(b0[:, None] + by[:, None] * ys) / a[:, None]
+    disc_front = np.zeros(depth.shape)  # the front blob's disc / a^2, for the rim
+    for i, ((c0, r0), (c1, r1)) in enumerate(zip(first.tolist(), stop.tolist())):
         if c0 >= c1 or r0 >= r1:
             continue
-        u, v = xs[c0:c1], ys[r0:r1]
-        disc = np.add.outer((kyy * v + ky) * v + k00, (kxx * u + kx) * u)
-        cross = np.outer(v, u)
-        cross *= kxy
-        disc += cross
-        lam = np.sqrt(np.maximum(disc, 0))
-        lam += np.add.outer(k0 + kby * v, kbx * u)
-        lam /= -ka
+        disc = np.add.outer(DV[i, r0:r1], DU[i, c0:c1])
+        disc += np.multiply.outer(ys[r0:r1], KUV[i, c0:c1])
+        lam = np.add.outer(BV[i, r0:r1], BU[i, c0:c1])
+        lam -= np.sqrt(np.maximum(disc, 0))
         D = depth[r0:r1, c0:c1]
         nearer = (disc > 0) & (lam < D)
         np.copyto(D, lam, where=nearer)
@@ -158,7 +158,7 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     dep = depth[vv, uu]
     lab = label[vv, uu]
     origin = o00[0] + pixels[:, :1] * ox + pixels[:, 1:] * oy
-    hits = Hits(lab, dep, origin + dep[:, None] * d, np.minimum(disc_front[vv, uu] / a[lab], 1.0))
+    hits = Hits(lab, dep, origin + dep[:, None] * d, np.minimum(disc_front[vv, uu] * a[lab], 1.0))
     return pixels, hits, box
 
 
