@@ -55,7 +55,7 @@ def _track(args) -> int:
 def _fit(args) -> int:
     try:
         job = load_fit(args.job)
-        res = fit_pose(job.skeleton, job.guess, job.clicks, job.mode)
+        res = fit_pose(job.skeleton, job.guess, job.clicks, job.mode, job.fit_lengths)
     except (JobError, FitError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

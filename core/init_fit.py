@@ -90,6 +90,10 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
              for a in sk.ancestors(sk.index(n))[1:]}
     swings = sum(2 if sk.kinds[j] == BALL else 1 for j in joints if j in below)
     _check(sk, clicks, n_root + swings)
+    if fit_lengths and len(clicks) == 1:
+        raise FitError("one view cannot tell a longer bone from one turned out of the image "
+                       "plane: fit the pose with the lengths as they are, or click the "
+                       "joints in a second view")
 
     def unpack(x):
         R = guess.rotations.copy()

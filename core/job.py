@@ -306,11 +306,13 @@ class FitJob:
     cameras: list[View]
     clicks: list[dict[str, np.ndarray]]
     mode: str
+    fit_lengths: bool = True  # also fit the bone lengths (needs two views or more)
 
 
 def load_fit(path: str | Path) -> FitJob:
     """Read and validate a fit file (a tracking job's ``skeleton``, ``initial``, ``views``
-    with cameras and no images needed, ``mode``, and ``clicks``: per view, joint -> [x, y])."""
+    with cameras and no images needed, ``mode``, ``clicks``: per view, joint -> [x, y], and
+    optionally ``fit_lengths``, true unless set false)."""
     path = Path(path)
     d = _read_json(path, "fit file")
     base, where = path.parent, path.name
@@ -329,8 +331,9 @@ def load_fit(path: str | Path) -> FitJob:
             if name not in sk.names:
                 raise JobError(f"{w}.{name}: no such joint in the BVH")
         clicks.append({name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()})
+    fit_lengths = _field(d, "fit_lengths", where, bool) if "fit_lengths" in d else True
     return FitJob(sk, bvh, initial_pose(sk, init_bvh, frame, cameras), cameras, clicks,
-                  _mode(d, where))
+                  _mode(d, where), fit_lengths)
 
 
 def world_root(mode: str, first_camera: View, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:

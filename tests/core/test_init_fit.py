@@ -117,6 +117,37 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
     assert res.residual_px < 2
 
 
+def test_one_view_with_known_lengths_recovers_each_clicked_limb_up_to_its_mirror_in_depth(
+        cmu_walk):
+    # one orthographic view shows a limb's image and, given its length, the size of its depth
+    # component but not its sign: a limb pointing 10 degrees toward the camera looks like one
+    # pointing 10 degrees away. Lengths cannot be fitted from one view (a longer limb turned
+    # further out of the image plane looks the same), so they are given
+    b, sk = _body(cmu_walk)
+    R_guess, p_guess = b.frame_pose(590)
+    R_true, p_true = _representable(sk, R_guess, *b.frame_pose(600))
+    views = _views(1)
+    clicks = _clicks(sk, R_true, p_true, views, np.random.default_rng(0), noise=0.0)
+    res = fit_pose(sk, BodyPose(R_guess, p_guess, views), clicks, CALIBRATED, fit_lengths=False)
+    assert res.residual_px < 0.1
+    Rc = views[0].pose.R  # compare in the camera's frame, z along the view
+    X = sk.world_positions(R_true, p_true) @ Rc.T
+    Y = res.skeleton.world_positions(res.pose.rotations, res.pose.root_position) @ Rc.T
+    checked, mirrored = 0, 0
+    for a, c in LIMBS:
+        if a not in clicks[0] or c not in clicks[0]:
+            continue  # an end not clicked in the one view: nothing pins the limb
+        ia, ic = sk.index(a), sk.index(c)
+        true, got = X[ic] - X[ia], Y[ic] - Y[ia]
+        err = [np.degrees(se3.angle_between_vectors(got, t)) for t in (true, true * [1, 1, -1])]
+        assert min(err) < 0.5, (a, c, err)
+        checked += 1
+        mirrored += err[1] < err[0]
+    assert checked >= 6
+    # the ambiguity is real here: the starting guess put some limbs on the other side
+    assert mirrored >= 1
+
+
 def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
     import json
     import subprocess
@@ -163,6 +194,14 @@ def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
                           text=True)
     assert proc.returncode == 2
     assert "bad.json.clicks: expected one object per view (3), got 2" in proc.stderr
+    one = dict(fit, views=fit["views"][:1], clicks=fit["clicks"][:1])
+    for name, extra, code, says in [("one.json", {}, 2, "one view cannot tell a longer bone"),
+                                    ("pose.json", {"fit_lengths": False}, 0, "fitted")]:
+        (tmp_path / name).write_text(json.dumps(dict(one, **extra)))
+        proc = subprocess.run([sys.executable, "-m", "core", "fit", str(tmp_path / name),
+                               "--out", str(tmp_path / "x.bvh")], cwd=root,
+                              capture_output=True, text=True)
+        assert proc.returncode == code and says in proc.stderr + proc.stdout, proc.stderr
 
 
 def test_degenerate_clicks_get_a_clear_message(cmu_walk):
@@ -178,3 +217,6 @@ def test_degenerate_clicks_get_a_clear_message(cmu_walk):
         fit_pose(sk, BodyPose(R, p, views), line, CALIBRATED)
     with pytest.raises(FitError, match="no joint named 'Tail'"):
         fit_pose(sk, BodyPose(R, p, views), [{"Tail": (1, 2)}], CALIBRATED)
+    good = [{n: views[0].project(X[sk.index(n)]) for n in CLICKED}]
+    with pytest.raises(FitError, match="one view cannot tell a longer bone"):
+        fit_pose(sk, BodyPose(R, p, views), good, CALIBRATED, fit_lengths=True)
