@@ -111,7 +111,11 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
         return
     # measured at 1 px click noise on a 700-pixel body over seeds 0-9: mean 0.7 (calibrated)
     # and 0.9 (independent) degrees, worst limb 1.2-2.8; the issue asks for every limb within
-    # 2 degrees and 2 %
+    # 2 degrees and 2 %. The worst is the left forearm, 74 px long, whose wrist is missing in
+    # one view while the other two are 30 degrees apart: the click noise carried through the
+    # fit (finite differences of the fitted direction in every click coordinate) gives it
+    # 1.9 degrees RMS at 1 px, the other limbs 0.4-1.7, so a 2-degree bound on every limb of
+    # every seed is more than these clicks hold
     assert np.mean(errs) < 1.5 and np.max(errs) < 3.0, errs
     assert np.max(np.abs(lens)) < (0.02 if mode == CALIBRATED else 0.05), lens
     assert res.residual_px < 2
