@@ -97,6 +97,20 @@ def hinge_from_twists(W: np.ndarray, old_axis: np.ndarray) -> tuple[np.ndarray, 
     return xi[3:], np.cross(xi[3:], xi[:3])
 
 
+def without_spin(W: np.ndarray, poses: Sequence[BodyPose], sk: Skeleton, joint: int
+                 ) -> np.ndarray:
+    """The twists W (6, T - 1) of ``segment_twists`` with each step's turn about the
+    joint's bone (toward its child, at the later pose) taken out. A segment's blob is round
+    about its bone, so its pixels say little of how it spins there, and what they say drew
+    a hinge's axis off by 2 degrees when tracked from the capture's own poses; a hinge's
+    axis lies across its bone, so no signal of it is lost."""
+    bone = sk.bone_frame(joint)[0]
+    b = np.array([p.rotations[joint] @ bone for p in poses[1:]])  # (T - 1, 3)
+    out = W.copy()
+    out[3:] -= (b * np.sum(W[3:].T * b, axis=1, keepdims=True)).T
+    return out
+
+
 def centre_from_twists(W: np.ndarray, rcond: float = 0.1) -> np.ndarray:
     """The point p (3,) all twists W (6, T) turn about: v(t) = p x w(t), least squares. A
     ball that turned about one axis only (a knee kept as a ball) does not show where along
@@ -204,7 +218,7 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
                 # a hinge turns about R_j a in the frame before its rotation (R_j = R_j(0)
                 # exp(theta a)), so the axis found there is taken back through R_j(0)
                 R0 = poses[0].rotations[j]
-                axis, point = hinge_from_twists(W, R0 @ sk.axes[j])
+                axis, point = hinge_from_twists(without_spin(W, poses, sk, j), R0 @ sk.axes[j])
                 axis = R0.T @ axis
                 if planar:  # the axis stays along the view; the centre moves across it
                     axis = sk.axes[j]

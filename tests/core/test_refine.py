@@ -15,6 +15,7 @@ from core.refine import (
     moved_joint,
     refine,
     segment_twists,
+    without_spin,
 )
 from core.skeleton import human_template, planar_chain_template
 from core.tracker import Tracker
@@ -36,6 +37,27 @@ def test_the_rank_one_factorisation_recovers_a_hinge_and_a_ball_centre():
     spins = rng.normal(0, 0.2, (3, 30))  # a ball: a new axis every step, one centre
     W = np.vstack([np.cross(point, spins.T).T, spins])
     np.testing.assert_allclose(centre_from_twists(W), point, atol=1e-9)
+
+
+def test_a_spin_about_the_bone_no_longer_tilts_a_hinge_axis():
+    # a knee (axis x) under a shank that swings through the steps; each step also reads a
+    # spin about the shank in step with the knee's turn, as pixels of a round blob may
+    sk = human_template()
+    j = sk.index("LeftKnee")
+    axis = sk.axes[j] / np.linalg.norm(sk.axes[j])
+    bone = sk.bone_frame(j)[0]
+    rates = np.linspace(0.05, 0.3, 20) * np.sign(np.sin(np.arange(20)))
+    angles = np.concatenate([[0.0], np.cumsum(rates)])
+    poses = [BodyPose(np.stack([np.eye(3)] * sk.n_joints), np.zeros(3), [])
+             for _ in angles]
+    for p, a in zip(poses, angles):
+        p.rotations[j] = se3.exp_so3(axis * a)
+    spin = np.array([p.rotations[j] @ bone for p in poses[1:]]).T * 0.3 * rates
+    W = np.vstack([np.zeros((3, 20)), np.outer(axis, rates) + spin])
+    tilted = hinge_from_twists(W, axis)[0]
+    assert np.degrees(se3.angle_between_vectors(tilted, axis)) > 3  # the spin draws it off
+    got = hinge_from_twists(without_spin(W, poses, sk, j), axis)[0]
+    np.testing.assert_allclose(got, axis, atol=1e-9)
 
 
 def test_moving_a_joint_keeps_the_body_at_rest_and_carries_a_pose():
