@@ -34,13 +34,12 @@ def blob_frames(blobs: list[Ellipsoid], g: np.ndarray) -> tuple[np.ndarray, np.n
 
     g: (J, 4, 4) segment motions, reference frame to world.
     """
-    A = np.empty((len(blobs), 3, 3))
-    C = np.empty((len(blobs), 3))
-    for i, b in enumerate(blobs):
-        R, p = g[b.joint, :3, :3], g[b.joint, :3, 3]
-        A[i] = (b.Q / b.radii).T @ R.T
-        C[i] = R @ b.centre + p
-    return A, C
+    joints = np.array([b.joint for b in blobs], dtype=int)
+    to_unit = np.array([b.Q / b.radii for b in blobs]).reshape(-1, 3, 3)  # Q diag(1 / r)
+    centres = np.array([b.centre for b in blobs]).reshape(-1, 3)
+    R, p = g[joints, :3, :3], g[joints, :3, 3]
+    A = np.einsum("eba,ecb->eac", to_unit, R)  # (Q diag(1 / r))^T R^T
+    return A, np.einsum("eab,eb->ea", R, centres) + p
 
 
 def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid], g: np.ndarray) -> Hits:

@@ -48,7 +48,7 @@ class NormalEquations:
         self.rows += len(r)
 
 
-def mixture_cost(r: np.ndarray, sigma: float, outlier: float) -> np.ndarray:
+def mixture_cost(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
     """Per-pixel cost -log(exp(-r^2 / 2 sigma^2) + outlier), shifted to 0 at r = 0.
 
     ``outlier`` is the flat density relative to the Gaussian's peak; a pixel that is hidden or
@@ -56,7 +56,7 @@ def mixture_cost(r: np.ndarray, sigma: float, outlier: float) -> np.ndarray:
     return np.log1p(outlier) - np.log(np.exp(-0.5 * (r / sigma) ** 2) + outlier)
 
 
-def support_weights(r: np.ndarray, sigma: float, outlier: float) -> np.ndarray:
+def support_weights(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
     """IRLS weights of :func:`mixture_cost`: the inlier posterior over sigma^2 (EM E-step)."""
     g = np.exp(-0.5 * (r / sigma) ** 2)
     return g / (g + outlier) / sigma**2

@@ -124,7 +124,9 @@ class TrackResult:
 
 @dataclass
 class _PointSet:
-    """Body pixels of one earlier frame in one view, ready to be mapped to the new frame."""
+    """Body pixels of earlier frames in one view, ready to be mapped to the new frame: one
+    frame's, or several frames' one after the other (``lengths``: how many each; each has
+    its own noise scale)."""
 
     view: int
     seg_joint: np.ndarray  # (N,) joint whose segment holds the point
@@ -132,6 +134,17 @@ class _PointSet:
     ref: np.ndarray  # (N, 3) reference-frame point
     value: np.ndarray  # (N,) intensity in that frame
     weight: np.ndarray  # (N,) rim weight times the set's weight
+    lengths: tuple[int, ...] = ()  # points per frame, when several frames are joined
+
+    @staticmethod
+    def joined(sets: list[_PointSet]) -> _PointSet:
+        """One set of the points of ``sets`` (all of one view), in order."""
+        if len(sets) == 1:
+            return sets[0]
+        return _PointSet(sets[0].view, *(np.concatenate([getattr(ps, f) for ps in sets])
+                                         for f in ("seg_joint", "blob", "ref", "value",
+                                                   "weight")),
+                         tuple(len(ps.value) for ps in sets))
 
 
 @dataclass
@@ -357,7 +370,7 @@ class Tracker:
 
     # --- one level -----------------------------------------------------------------------
     def _sample(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
-                lv: int, sigmas: list[float], fgs: list | None = None) -> _Samples:
+                lv: int, sigmas: list[np.ndarray], fgs: list | None = None) -> _Samples:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
         where the point is hidden by another blob or off the image) and what the rows need."""
         s = self.settings
@@ -399,27 +412,28 @@ class Tracker:
             n_inside[ps.view] += int(inside.sum())
             r = vals[ok, 0] - ps.value[ok]
             c = np.full(len(pix), np.nan)
-            c[ok] = ps.weight[ok] * mixture_cost(r, sigma, s.outlier_density)
+            c[ok] = ps.weight[ok] * mixture_cost(r, sigma[ok], s.outlier_density)
             costs.append(c)
             parts.append((ok, q[ok], vals[ok, 1:3], r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         shape_cost, shape_parts)
 
-    def _pixel_weights(self, ps: _PointSet, ok: np.ndarray, r: np.ndarray, sigma: float
+    def _pixel_weights(self, ps: _PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
                        ) -> np.ndarray:
-        """Weights of a point set's usable points ``ok`` with residuals ``r``: their rim
-        weight times the EM support posterior."""
-        return ps.weight[ok] * support_weights(r, sigma, self.settings.outlier_density)
+        """Weights of a point set's usable points ``ok`` with residuals ``r`` (the set's
+        points' noise scales ``sigma``): their rim weight times the EM support posterior."""
+        return ps.weight[ok] * support_weights(r, sigma[ok], self.settings.outlier_density)
 
     def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
-                          sigmas: list[float], lv: int) -> NormalEquations:
+                          sigmas: list[np.ndarray], lv: int) -> NormalEquations:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
-        and the silhouette's rows (each mismatched pixel's two coordinates)."""
-        ne = NormalEquations.zeros(self.n_params)
+        and the silhouette's rows (each mismatched pixel's two coordinates); one block of
+        rows per view."""
+        pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, q, grad, r, w)
         for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
             if len(ok):
-                w = self._pixel_weights(ps, ok, r, sigma)
-                ne.add(rows(kin, ps.view, self.mode, ps.seg_joint[ok], q, grad), r, w)
+                pieces[ps.view].append((ps.seg_joint[ok], q, grad, r,
+                                        self._pixel_weights(ps, ok, r, sigma)))
         s = self.settings
         g = 2**lv * self._grid(lv)  # full-resolution pixels per map pixel
         for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
@@ -435,21 +449,31 @@ class Tracker:
             unit[:n, 0] = unit[n:, 1] = 1.0
             r = (q[:, :2] + view.center - target).T.ravel()
             w = np.tile(pair_w, 2) * (s.silhouette * every / g**2)
-            ne.add(rows(kin, c, self.mode, np.tile(joints, 2), np.tile(q, (2, 1)), unit), r, w)
+            pieces[c].append((np.tile(joints, 2), np.tile(q, (2, 1)), unit, r, w))
+        ne = NormalEquations.zeros(self.n_params)
+        for c, view_pieces in enumerate(pieces):
+            if view_pieces:
+                joints, q, grad, r, w = (np.concatenate(x) for x in zip(*view_pieces))
+                ne.add(rows(kin, c, self.mode, joints, q, grad), r, w)
         return ne
 
-    def _sigmas(self, est: BodyPose, kin: Kinematics, sets, levels) -> list[float]:
-        """Residual scale of each point set at the level's starting pose (kept through the
-        level so that costs compare)."""
+    def _sigmas(self, est: BodyPose, kin: Kinematics, sets, levels) -> list[np.ndarray]:
+        """Residual scale of each point set's points (N,), one per frame it joins, at the
+        level's starting pose (kept through the level so that costs compare)."""
         out = []
         for ps in sets:
             view = est.views[ps.view]
             pix = view.project(kin.world_points(ps.seg_joint, ps.ref))
             vals, inside = imagelib.sample(levels[ps.view], pix)
-            out.append(robust_scale(vals[inside, 0] - ps.value[inside], self.settings.noise_floor))
+            r = vals[:, 0] - ps.value
+            lengths = ps.lengths or (len(r),)
+            scales = [robust_scale(part_r[part_in], self.settings.noise_floor)
+                      for part_r, part_in in zip(np.split(r, np.cumsum(lengths)[:-1]),
+                                                 np.split(inside, np.cumsum(lengths)[:-1]))]
+            out.append(np.repeat(scales, lengths))
         return out
 
-    def _residual(self, sets: list[_PointSet], smp: _Samples, sigmas: list[float]) -> float:
+    def _residual(self, sets: list[_PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
         """RMS brightness error of the pixels that follow the body (support-weighted), in
         image units: what the report calls a frame's residual."""
         num = den = 0.0
@@ -520,15 +544,16 @@ class Tracker:
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for lv in reversed(range(s.levels)):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
-            sets = []
+            sets = []  # per view, the previous frame's points then the key frame's
             for c in range(self.seq.n_views):
-                sets.append(self._point_set(prev, kin_prev, c, prev_frame, lv, 1.0))
+                view_sets = [self._point_set(prev, kin_prev, c, prev_frame, lv, 1.0)]
                 if s.key_weight > 0 and key_frame != prev_frame:
                     k = (key_frame, c, lv)
                     if k not in self._key_sets:
                         self._key_sets[k] = self._point_set(key, kin_key, c, key_frame, lv,
                                                             s.key_weight)
-                    sets.append(self._key_sets[k])
+                    view_sets.append(self._key_sets[k])
+                sets.append(_PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and lv == self._search_level():
                 searched = self._search_limbs(est, frame, key, key_frame)
