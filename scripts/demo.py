@@ -117,7 +117,6 @@ def main(argv=None) -> int:
           f"{np.mean([got.limb_deg[k] for k in legs]):.1f} deg, all eight limbs "
           f"{got.limb_mean_deg:.1f} deg (first frame held still: {still.limb_mean_deg:.1f} deg)")
     print("per limb (deg): " + ", ".join(f"{k} {v:.1f}" for k, v in got.limb_deg.items()))
-    print("per limb (deg): " + ", ".join(f"{k} {v:.1f}" for k, v in got.limb_deg.items()))
     return 0
 
 
