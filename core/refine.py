@@ -86,12 +86,23 @@ def _free_twist(kin: Kinematics, pixels: list, segments: np.ndarray, basis: np.n
     return np.concatenate([RF.T @ (v_c + np.cross(w, pF - c)), RF.T @ w])
 
 
-def hinge_from_twists(W: np.ndarray, old_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def hinge_from_twists(W: np.ndarray, old_axis: np.ndarray, rounds: int = 10
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """Axis (3,) and the point (3,) on it nearest the frame's origin of the rank-1 twist
     matrix W (6, T): its first left singular vector, scaled to a unit rotation part and
-    turned to agree with ``old_axis``."""
-    u = np.linalg.svd(W, full_matrices=False)[0][:, 0]
-    xi = u / np.linalg.norm(u[3:])
+    turned to agree with ``old_axis``. Steps that stray from the rank-1 twist (a segment
+    mostly hidden in some view reads a wrong one) are discounted: the factorisation is
+    repeated ``rounds`` times with Cauchy weights on each step's distance from the twist,
+    at twice the distances' robust spread."""
+    weights = np.ones(W.shape[1])
+    for r in range(rounds):
+        u = np.linalg.svd(W * weights, full_matrices=False)[0][:, 0]
+        xi = u / np.linalg.norm(u[3:])
+        miss = np.linalg.norm(W - np.outer(xi, W.T @ xi / (xi @ xi)), axis=0)
+        spread = 1.4826 * np.median(miss)
+        if r == rounds - 1 or spread <= 0:
+            break
+        weights = 1 / np.sqrt(1 + (miss / (2 * spread)) ** 2)
     if xi[3:] @ old_axis < 0:
         xi = -xi
     return xi[3:], np.cross(xi[3:], xi[:3])

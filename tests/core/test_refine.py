@@ -39,6 +39,21 @@ def test_the_rank_one_factorisation_recovers_a_hinge_and_a_ball_centre():
     np.testing.assert_allclose(centre_from_twists(W), point, atol=1e-9)
 
 
+def test_a_few_stray_steps_do_not_tilt_a_hinge_axis():
+    rng = np.random.default_rng(0)
+    axis = np.array([0.8, 0.6, 0.0])
+    point = np.array([0.0, 0.0, 0.05])
+    rates = rng.normal(0, 0.2, 30)
+    W = np.outer(np.concatenate([np.cross(point, axis), axis]), rates)
+    W += rng.normal(0, 1e-3, W.shape)
+    W[:, [3, 11, 20]] += rng.normal(0, 0.1, (6, 3))  # steps where the segment was hidden
+    plain = hinge_from_twists(W, axis, rounds=1)[0]  # one unweighted factorisation
+    assert np.degrees(se3.angle_between_vectors(plain, axis)) > 3
+    got_axis, got_point = hinge_from_twists(W, axis)
+    assert np.degrees(se3.angle_between_vectors(got_axis, axis)) < 0.3
+    np.testing.assert_allclose(got_point, point, atol=2e-3)
+
+
 def test_a_spin_about_the_bone_no_longer_tilts_a_hinge_axis():
     # a knee (axis x) under a shank that swings through the steps; each step also reads a
     # spin about the shank in step with the knee's turn, as pixels of a round blob may
