@@ -1,0 +1,99 @@
+"""How much a tracking result depends on where it starts: the three-view calibrated walk of
+bench/walk_benchmark.py tracked from several first frames, forward and backward, each run
+scored against the capture, with their mean.
+
+    python bench/start_spread.py [--cache .cache/walk] [--quick] [--settings JSON]
+
+A run starting on frame k of the 30 fps footage is posed there with the capture's pose; a
+15 fps run takes every other frame from there. Sixteen runs (15 fps forward from frames 0-5
+and backward from 118-113, 30 fps forward from 0 and 1 and backward from 118 and 117), or
+eight with --quick (15 fps forward from 0-3 and backward from 118 and 117, 30 fps forward
+from 0 and backward from 118). Two runs at a time, one per core.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from multiprocessing import Pool
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import evaluate  # noqa: E402
+from walk_benchmark import RUNS  # noqa: E402
+from walk_footage import CAPTURE_FPS, render, write_job  # noqa: E402
+
+from core.bvh import read_bvh  # noqa: E402
+from core.job import load_job  # noqa: E402
+from core.pose import BodyPose  # noqa: E402
+from core.tracker import Tracker, track  # noqa: E402
+
+N_FRAMES = 119  # the footage: frames 300-772 of the capture at 30 fps
+
+
+def starts(quick: bool) -> dict[str, list[int]]:
+    """Run name -> the footage frames it tracks, in order."""
+    fwd15, bwd15 = (range(4), (118, 117)) if quick else (range(6), range(118, 112, -1))
+    fwd30, bwd30 = ((0,), (118,)) if quick else ((0, 1), (118, 117))
+    runs = {f"15 fps forward from {k}": list(range(k, N_FRAMES, 2)) for k in fwd15}
+    runs |= {f"15 fps backward from {k}": list(range(k, -1, -2)) for k in bwd15}
+    runs |= {f"30 fps forward from {k}": list(range(k, N_FRAMES)) for k in fwd30}
+    runs |= {f"30 fps backward from {k}": list(range(k, -1, -1)) for k in bwd30}
+    return runs
+
+
+def one_run(args: tuple) -> tuple[str, evaluate.Scores, int, float]:
+    """Track one run's frames from the capture's pose on its first; its scores, the frames
+    it tracked and its frames per second."""
+    name, frames, job_path, truth_path = args
+    job = load_job(job_path)
+    R, P = read_bvh(truth_path).poses()
+    truth = (R[frames], P[frames])
+    initial = BodyPose(truth[0][0].copy(), truth[1][0].copy(), [c.copy() for c in job.cameras])
+    tracker = Tracker(job.skeleton, job.images, job.mode, job.settings)
+    t0 = time.perf_counter()
+    result = track(tracker, initial, frames)
+    fps = (len(result.frames) - 1) / (time.perf_counter() - t0)
+    est = (np.array([f.pose.rotations for f in result.frames]),
+           np.array([f.pose.root_position for f in result.frames]))
+    sk = job.skeleton
+    tracked = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+    return name, evaluate.score(sk, tracked, est, truth), len(result.frames), fps
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
+    ap.add_argument("--quick", action="store_true", help="eight runs instead of sixteen")
+    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
+    a = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
+    views, mode, _ = RUNS["3 views calibrated 30 fps"]
+    job_path = write_job(a.cache, "start_spread", views, mode, info["frames"], info["cameras"],
+                         json.loads(a.settings), 4 / CAPTURE_FPS)
+    runs = starts(a.quick)
+    with Pool(2) as pool:
+        out = pool.map(one_run, [(name, frames, str(job_path), str(a.cache / "truth.bvh"))
+                                 for name, frames in runs.items()])
+    limbs = list(out[0][1].limb_deg)
+    print("| run | frames | limb dir. err (8 limbs) | " + " | ".join(limbs) + " | fps |")
+    print("|---" * (len(limbs) + 4) + "|")
+    for name, scores, n, fps in out:
+        print(f"| {name} | {n}/{len(runs[name])} | {scores.limb_mean_deg:.1f}° | "
+              + " | ".join(f"{scores.limb_deg[k]:.1f}" for k in limbs) + f" | {fps:.1f} |")
+    means = [s.limb_mean_deg for _, s, _, _ in out]
+    print(f"\nmean of the {len(out)} runs: {np.mean(means):.2f}° (median {np.median(means):.1f},"
+          f" worst {np.max(means):.1f}); {time.perf_counter() - t0:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
