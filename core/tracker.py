@@ -467,9 +467,9 @@ class Tracker:
             vals, inside = imagelib.sample(levels[ps.view], pix)
             r = vals[:, 0] - ps.value
             lengths = ps.lengths or (len(r),)
+            cuts = np.cumsum(lengths)[:-1]
             scales = [robust_scale(part_r[part_in], self.settings.noise_floor)
-                      for part_r, part_in in zip(np.split(r, np.cumsum(lengths)[:-1]),
-                                                 np.split(inside, np.cumsum(lengths)[:-1]))]
+                      for part_r, part_in in zip(np.split(r, cuts), np.split(inside, cuts))]
             out.append(np.repeat(scales, lengths))
         return out
 
