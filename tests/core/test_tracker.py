@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from core import se3
+from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.skeleton import human_template
-from core.tracker import Tracker, TrackerSettings, track
+from core.tracker import Tracker, TrackerSettings, _PointSet, track
 from support.synthetic import render, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
@@ -205,3 +206,19 @@ def test_a_hinge_is_held_within_its_limits(body):
     sk.limits[j] = np.radians([-10, 10])
     held = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1]).frames[1].pose
     assert 5 < np.degrees(sk.hinge_angle(j, held.rotations[j])) <= 10 + 1e-9
+
+
+def test_a_joined_point_set_keeps_each_frames_noise_scale(body):
+    """A view's previous-frame and key-frame points go through the tracker as one set; each
+    frame's points keep the residual scale they would have alone."""
+    sk, pose = body
+    frames = [[render(sk, pose, c, noise=n, seed=k) for k, n in enumerate((0.0, 0.1, 0.01))]
+              for c in range(3)]
+    tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(silhouette=0))
+    kin = Kinematics(sk, pose)
+    levels = [tracker.seq.pyramid(c, 2)[0] for c in range(3)]
+    prev, key = (tracker._point_set(pose, kin, 0, f, 0, 1.0) for f in (1, 0))
+    apart = tracker._sigmas(pose, kin, [prev, key], levels)
+    joined = tracker._sigmas(pose, kin, [_PointSet.joined([prev, key])], levels)[0]
+    np.testing.assert_array_equal(joined, np.concatenate(apart))
+    assert apart[0][0] > 2 * apart[1][0]  # the noisy frame's scale is its own
