@@ -9,10 +9,11 @@ do shows. Written in the joint's frame before its rotation (the parent's axes, a
 a hinge's twists over time are one twist scaled by its angular velocity: the 6 x T matrix of
 them has rank 1, and its first singular vector, scaled so that its rotation part is a unit
 vector, is the hinge's twist (v, w) = (p x w, w): its axis w and the point p on it nearest
-the old centre. A ball joint turns about varying axes through one centre p, so v(t) =
-p x w(t) gives p by least squares. The refined joints are moved there (its children's
-offsets compensate, so the body at rest is unchanged), and the footage is tracked again,
-until no joint moves.
+the old centre (each step's spin about the bone, which a round blob barely sees, taken out
+first, and steps that stray from the rank-1 twist discounted). A ball joint turns about
+varying axes through one centre p, so v(t) = p x w(t) gives p by least squares. The
+refined joints are moved there (its children's offsets compensate, so the body at rest is
+unchanged), and the footage is tracked again, until no joint moves.
 
 Calibrated views (one world frame). Planar mode, for a body seen side-on by one view: the
 twists are kept in the image plane (translation along the image axes, rotation about the view
