@@ -64,7 +64,7 @@ def one_run(args: tuple) -> tuple[str, evaluate.Scores, int, float]:
     est = (np.array([f.pose.rotations for f in result.frames]),
            np.array([f.pose.root_position for f in result.frames]))
     sk = job.skeleton
-    tracked = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+    tracked = sk.tracked_joint_names()
     return name, evaluate.score(sk, tracked, est, truth), len(result.frames), fps
 
 

@@ -61,7 +61,7 @@ def one_step(job_path: Path, truth: tuple) -> evaluate.Scores:
         res = tracker.track_frame(pose(i - 1), i - 1, pose(0), 0, pred, i)
         est_R.append(res.pose.rotations)
         est_p.append(res.pose.root_position)
-    tracked = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+    tracked = sk.tracked_joint_names()
     return evaluate.score(sk, tracked, (np.array(est_R), np.array(est_p)), truth)
 
 
@@ -102,7 +102,7 @@ def main(argv=None) -> int:
         rep = json.loads(rep_path.read_text())
         job = load_job(job_path)
         sk = job.skeleton
-        tracked_names = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+        tracked_names = sk.tracked_joint_names()
         sel = slice(None, None, step // 4)
         truth = (truth_all[0][sel], truth_all[1][sel])
         est = read_bvh(out).poses()

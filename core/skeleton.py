@@ -152,6 +152,10 @@ class Skeleton:
         lo, hi = self.limits[j]
         return min(lo, theta) - theta, max(hi, theta) - theta
 
+    def tracked_joint_names(self) -> list[str]:
+        """Names of the joints that turn (ball or hinge), parents first."""
+        return [n for n, kind in zip(self.names, self.kinds) if kind in (BALL, HINGE)]
+
     def dof_names(self) -> list[str]:
         names = []
         for j, kind in enumerate(self.kinds):

@@ -105,7 +105,7 @@ def main(argv=None) -> int:
         R, root = bridge.pose_from_armature(arm, tracked)
         est_R.append(R)
         est_p.append(root)
-    names = [tracked.names[j] for j in sorted(set(tracked.dof_joints_and_axes()[0].tolist()))]
+    names = tracked.tracked_joint_names()
     got = evaluate.score(sk, names, (np.array(est_R), np.array(est_p)), truth)
     still = evaluate.score(sk, names, evaluate.held_still(truth), truth)
     print(f"\ntracked {result.frames_tracked} frames; last residual {result.last_residual:.4f}"

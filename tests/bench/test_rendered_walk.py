@@ -37,7 +37,7 @@ def test_rendered_walk_tracks_its_legs_and_neck(walk, tmp_path):
                           text=True)
     assert proc.returncode == 0, proc.stderr
     sk = load_job(job).skeleton
-    tracked = [sk.names[j] for j in sorted(set(sk.dof_joints_and_axes()[0].tolist()))]
+    tracked = sk.tracked_joint_names()
     truth = read_bvh(folder / "truth.bvh").poses()
     got = evaluate.score(sk, tracked, read_bvh(out).poses(), truth)
     still = evaluate.score(sk, tracked, evaluate.held_still(truth), truth)

@@ -90,3 +90,11 @@ def test_parents_must_precede_children():
 
     with pytest.raises(ValueError, match="parents must come before"):
         Skeleton(names=["a", "b"], parents=[-1, 1], offsets=np.zeros((2, 3)))
+
+
+def test_the_tracked_joints_are_those_with_degrees_of_freedom_in_joint_order():
+    sk = human_template()
+    dof_joints = sk.dof_joints_and_axes()[0]
+    want = [sk.names[j] for j in sorted(set(dof_joints.tolist()))]
+    assert sk.tracked_joint_names() == want
+    assert len(want) == 9 and "LeftKnee" in want and sk.names[0] not in want
