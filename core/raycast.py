@@ -29,17 +29,22 @@ class Hits:
     rim: np.ndarray
 
 
+def _posed(blobs: list[Ellipsoid], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per blob, its segment's world rotation (E, 3, 3) and its world centre (E, 3)."""
+    joints = np.array([b.joint for b in blobs], dtype=int)
+    R, p = g[joints, :3, :3], g[joints, :3, 3]
+    centres = np.array([b.centre for b in blobs]).reshape(-1, 3)
+    return R, np.einsum("eab,eb->ea", R, centres) + p
+
+
 def blob_frames(blobs: list[Ellipsoid], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per blob, world-to-normalised linear map (E, 3, 3) and world centre (E, 3).
 
     g: (J, 4, 4) segment motions, reference frame to world.
     """
-    joints = np.array([b.joint for b in blobs], dtype=int)
+    R, C = _posed(blobs, g)
     to_unit = np.array([b.Q / b.radii for b in blobs]).reshape(-1, 3, 3)  # Q diag(1 / r)
-    centres = np.array([b.centre for b in blobs]).reshape(-1, 3)
-    R, p = g[joints, :3, :3], g[joints, :3, 3]
-    A = np.einsum("eba,ecb->eac", to_unit, R)  # (Q diag(1 / r))^T R^T
-    return A, np.einsum("eab,eb->ea", R, centres) + p
+    return np.einsum("eba,ecb->eac", to_unit, R), C  # (Q diag(1 / r))^T R^T
 
 
 def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid], g: np.ndarray) -> Hits:
@@ -71,9 +76,7 @@ def blob_boxes(view: View, blobs: list[Ellipsoid], g: np.ndarray) -> np.ndarray:
     """Pixel extents (E, 4) = (xmin, ymin, xmax, ymax) of every blob's outline, as floats.
 
     An ellipsoid's half extent along image axis i is |row i of s R_cam R_seg Q diag(r)|."""
-    joints = np.array([b.joint for b in blobs], dtype=int)
-    Rs, ps = g[joints, :3, :3], g[joints, :3, 3]
-    centres = np.einsum("eab,eb->ea", Rs, np.array([b.centre for b in blobs])) + ps
+    Rs, centres = _posed(blobs, g)
     axes = np.einsum("eab,ebc->eac", Rs, np.array([b.Q for b in blobs]))
     axes = axes * np.array([b.radii for b in blobs])[:, None, :]
     M = view.pose.s * np.einsum("ab,ebc->eac", view.pose.R[:2], axes)
