@@ -154,6 +154,7 @@ class _Samples:
     costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
     parts: list  # per set: (indices of usable points, their q, image gradients, residuals)
     inside: np.ndarray  # (views,) fraction of each view's points inside its image
+    sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
     shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
 
@@ -370,9 +371,12 @@ class Tracker:
 
     # --- one level -----------------------------------------------------------------------
     def _sample(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
-                lv: int, sigmas: list[np.ndarray], fgs: list | None = None) -> _Samples:
+                lv: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
+                ) -> _Samples:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
-        where the point is hidden by another blob or off the image) and what the rows need."""
+        where the point is hidden by another blob or off the image) and what the rows need.
+        Without ``sigmas`` the points' noise scales are measured here (``_sigmas``): a
+        level's starting pose sets them, and its candidates are costed with them."""
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
@@ -396,11 +400,15 @@ class Tracker:
                 h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
                 shape_parts.append((self._blob_joints[hits.label[h]], hits.world[h],
                                     mm.target * (2**lv * g), mm.weight))
-        for ps, sigma in zip(sets, sigmas):
+        measured = []
+        for k, ps in enumerate(sets):
             view = est.views[ps.view]
             q = view.scaled(kin.world_points(ps.seg_joint, ps.ref))
             pix = q[:, :2] + view.center
             vals, inside = imagelib.sample(levels[ps.view], pix)
+            if sigmas is None:
+                measured.append(self._sigmas(ps, vals[:, 0] - ps.value, inside))
+            sigma = measured[-1] if sigmas is None else sigmas[k]
             p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / g).astype(int)
             lab = labels[ps.view]
             H, W = lab.shape
@@ -416,7 +424,7 @@ class Tracker:
             costs.append(c)
             parts.append((ok, q[ok], vals[ok, 1:3], r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
-                        shape_cost, shape_parts)
+                        measured if sigmas is None else sigmas, shape_cost, shape_parts)
 
     def _pixel_weights(self, ps: _PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
                        ) -> np.ndarray:
@@ -457,21 +465,14 @@ class Tracker:
                 ne.add(rows(kin, c, self.mode, joints, q, grad), r, w)
         return ne
 
-    def _sigmas(self, est: BodyPose, kin: Kinematics, sets, levels) -> list[np.ndarray]:
-        """Residual scale of each point set's points (N,), one per frame it joins, at the
-        level's starting pose (kept through the level so that costs compare)."""
-        out = []
-        for ps in sets:
-            view = est.views[ps.view]
-            pix = view.project(kin.world_points(ps.seg_joint, ps.ref))
-            vals, inside = imagelib.sample(levels[ps.view], pix)
-            r = vals[:, 0] - ps.value
-            lengths = ps.lengths or (len(r),)
-            cuts = np.cumsum(lengths)[:-1]
-            scales = [robust_scale(part_r[part_in], self.settings.noise_floor)
-                      for part_r, part_in in zip(np.split(r, cuts), np.split(inside, cuts))]
-            out.append(np.repeat(scales, lengths))
-        return out
+    def _sigmas(self, ps: _PointSet, r: np.ndarray, inside: np.ndarray) -> np.ndarray:
+        """Residual scale of a point set's points (N,) from their residuals ``r`` (N,) and
+        which fell inside the image: one scale per frame the set joins."""
+        lengths = ps.lengths or (len(r),)
+        cuts = np.cumsum(lengths)[:-1]
+        scales = [robust_scale(part_r[part_in], self.settings.noise_floor)
+                  for part_r, part_in in zip(np.split(r, cuts), np.split(inside, cuts))]
+        return np.repeat(scales, lengths)
 
     def _residual(self, sets: list[_PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
         """RMS brightness error of the pixels that follow the body (support-weighted), in
@@ -523,10 +524,9 @@ class Tracker:
         levels = [self.seq.pyramid(c, frame)[0] for c in range(self.seq.n_views)]
         sets = [self._point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
                 for c in range(self.seq.n_views)]
-        sigmas = self._sigmas(est, kin, sets, levels)
-        smp = self._sample(est, kin, sets, levels, 0, sigmas)
+        smp = self._sample(est, kin, sets, levels, 0)
         out = []
-        for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
+        for ps, sigma, (ok, q, grad, r) in zip(sets, smp.sigmas, smp.parts):
             w = self._pixel_weights(ps, ok, r, sigma)
             out.append((ps.view, ps.seg_joint[ok], q, grad, r, w))
         return out
@@ -564,8 +564,8 @@ class Tracker:
             # a silhouette where some limb cannot move yet would pull the rest in its place
             fgs = (self._foregrounds(frame, lv, key, key_frame, est, kin) if active.all()
                    else None)
-            sigmas = self._sigmas(est, kin, sets, levels)
-            smp = self._sample(est, kin, sets, levels, lv, sigmas, fgs)
+            smp = self._sample(est, kin, sets, levels, lv, None, fgs)
+            sigmas = smp.sigmas
             left = self._left_views(smp)
             if left:
                 return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
@@ -574,7 +574,7 @@ class Tracker:
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
             converged = False
-            for _ in range(s.iterations):
+            for it in range(s.iterations):
                 total_iters += 1
                 delta = self._within_limits(est, self._trust(solve(ne, lam, prior, offset,
                                                                     active)))
@@ -595,7 +595,8 @@ class Tracker:
                     if moved / 2**lv < s.converge_pixels:
                         converged = True
                         break
-                    ne = self._normal_equations(kin, sets, smp, sigmas, lv)
+                    if it + 1 < s.iterations:
+                        ne = self._normal_equations(kin, sets, smp, sigmas, lv)
                 else:
                     lam *= 4
                     if lam > 1e4:

@@ -218,7 +218,7 @@ def test_a_joined_point_set_keeps_each_frames_noise_scale(body):
     kin = Kinematics(sk, pose)
     levels = [tracker.seq.pyramid(c, 2)[0] for c in range(3)]
     prev, key = (tracker._point_set(pose, kin, 0, f, 0, 1.0) for f in (1, 0))
-    apart = tracker._sigmas(pose, kin, [prev, key], levels)
-    joined = tracker._sigmas(pose, kin, [_PointSet.joined([prev, key])], levels)[0]
+    apart = tracker._sample(pose, kin, [prev, key], levels, 0).sigmas
+    joined = tracker._sample(pose, kin, [_PointSet.joined([prev, key])], levels, 0).sigmas[0]
     np.testing.assert_array_equal(joined, np.concatenate(apart))
     assert apart[0][0] > 2 * apart[1][0]  # the noisy frame's scale is its own
