@@ -91,11 +91,13 @@ def _paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tupl
     """Set the pixels of ``mask`` (the box's size) that any ellipsoid's outline covers."""
     c, half, P = _outlines(view, A, C)
     lo, hi = _spans(c, half, P, box)
-    cols = np.arange(mask.shape[1])
-    for e in range(len(A)):
-        rows = np.flatnonzero(hi[e] > lo[e])
-        if len(rows):
-            mask[rows] |= (cols >= lo[e, rows, None]) & (cols < hi[e, rows, None])
+    e, rows = np.nonzero(hi > lo)
+    # +1 where a span starts, -1 one past its end: a pixel is covered where the running sum
+    # along its row is positive
+    edges = np.zeros((mask.shape[0], mask.shape[1] + 1), np.int32)
+    np.add.at(edges, (rows, lo[e, rows]), 1)
+    np.add.at(edges, (rows, hi[e, rows]), -1)
+    mask |= np.cumsum(edges[:, :-1], axis=1) > 0
 
 
 def _sums(c, half, P, box, S: np.ndarray) -> np.ndarray:
