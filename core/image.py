@@ -95,6 +95,7 @@ def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     maps[:N] = p
     vals = cv2.remap(level.stack, maps.reshape(rows, cols, 2), None, cv2.INTER_LINEAR,
                      borderMode=cv2.BORDER_REPLICATE)
-    vals = vals.reshape(-1, 3)[:N].copy()
-    vals[:, 1:] /= level.scale
-    return vals, inside
+    # per full-resolution pixel: the scale is a power of two, so multiplying by its inverse
+    # is exact
+    per_pixel = np.array([1.0, 1 / level.scale, 1 / level.scale], np.float32)
+    return vals.reshape(-1, 3)[:N] * per_pixel, inside
