@@ -43,8 +43,13 @@ def blob_frames(blobs: list[Ellipsoid], g: np.ndarray) -> tuple[np.ndarray, np.n
     g: (J, 4, 4) segment motions, reference frame to world.
     """
     R, C = _posed(blobs, g)
+    return _to_unit(blobs, R), C
+
+
+def _to_unit(blobs: list[Ellipsoid], R: np.ndarray) -> np.ndarray:
+    """World-to-normalised maps (E, 3, 3) of blobs whose segments turn by R (E, 3, 3)."""
     to_unit = np.array([b.Q / b.radii for b in blobs]).reshape(-1, 3, 3)  # Q diag(1 / r)
-    return np.einsum("eba,ecb->eac", to_unit, R), C  # (Q diag(1 / r))^T R^T
+    return np.einsum("eba,ecb->eac", to_unit, R)  # (Q diag(1 / r))^T R^T
 
 
 def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid], g: np.ndarray) -> Hits:
@@ -76,7 +81,12 @@ def blob_boxes(view: View, blobs: list[Ellipsoid], g: np.ndarray) -> np.ndarray:
     """Pixel extents (E, 4) = (xmin, ymin, xmax, ymax) of every blob's outline, as floats.
 
     An ellipsoid's half extent along image axis i is |row i of s R_cam R_seg Q diag(r)|."""
-    Rs, centres = _posed(blobs, g)
+    return _boxes(view, blobs, *_posed(blobs, g))
+
+
+def _boxes(view: View, blobs: list[Ellipsoid], Rs: np.ndarray, centres: np.ndarray
+           ) -> np.ndarray:
+    """``blob_boxes`` of blobs posed by ``_posed``."""
     axes = np.einsum("eab,ebc->eac", Rs, np.array([b.Q for b in blobs]))
     axes = axes * np.array([b.radii for b in blobs])[:, None, :]
     M = view.pose.s * np.einsum("ab,ebc->eac", view.pose.R[:2], axes)
@@ -99,7 +109,8 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
 
     Same result as :func:`cast` on those pixels, at a fraction of the work: under orthography
     the ray's start is affine in the pixel, so each blob's quadratic is evaluated on its box."""
-    boxes = blob_boxes(view, blobs, g) if blobs else np.zeros((0, 4))
+    Rs, C = _posed(blobs, g)  # once, for the boxes and the blobs' normalised frames
+    boxes = _boxes(view, blobs, Rs, C) if blobs else np.zeros((0, 4))
     box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if blobs else None
     if box is None:
         empty = np.zeros((0, 2))
@@ -109,7 +120,7 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     xs = np.arange(x0, x1, step, dtype=float)
     ys = np.arange(y0, y1, step, dtype=float)
     depth = np.full((len(ys), len(xs)), np.inf)
-    A, C = blob_frames(blobs, g)
+    A = _to_unit(blobs, Rs)
     o00, d = view.ray(np.array([[0.0, 0.0]]))
     ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
     oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00[0]
