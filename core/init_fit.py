@@ -3,9 +3,10 @@
 Unknowns: the root's pose (one world pose when the cameras are calibrated; otherwise each view's
 scale, rotation and image translation, paper section 2.6), every tracked joint's rotation
 (balls as rotation vectors, hinges as angles) and one length factor per bone, shared by the
-left and right bones of a pair. Residuals: each clicked joint's projection minus its click,
-in pixels, with a robust (soft-L1) loss, plus weak priors that keep unconstrained unknowns at
-the guess. Solved by ``scipy.optimize.least_squares`` with length factors bounded to [0.5, 2].
+left and right bones of a pair and by bones in line that meet at no click. Residuals: each
+clicked joint's projection minus its click, in pixels, with a robust (soft-L1) loss, plus
+weak priors that keep unconstrained unknowns at the guess. Solved by
+``scipy.optimize.least_squares`` with length factors bounded to [0.5, 2].
 """
 
 from __future__ import annotations
@@ -74,8 +75,17 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     clicked = {sk.index(n) for v in clicks for n in v}
     below = {a for c in clicked for a in sk.ancestors(c)}
 
+    def chain_start(j: int) -> int:
+        """The first joint of the unbranched run of bones that ends at j: bones meeting at a
+        joint that is neither clicked nor a branch can only be fitted as one (two spine bones
+        in line trade length freely), so they share a factor."""
+        p = int(sk.parents[j])
+        while p > 0 and p not in clicked and len(sk.children(p)) == 1:
+            j, p = p, int(sk.parents[p])
+        return j
+
     def group_key(j: int) -> str:
-        return symmetry_key(sk.names[j]) if j in below else "*body"
+        return symmetry_key(sk.names[chain_start(j)]) if j in below else "*body"
 
     bones = [j for j in range(1, sk.n_joints) if np.linalg.norm(sk.offsets[j]) > 1e-9]
     groups = sorted({group_key(j) for j in bones})

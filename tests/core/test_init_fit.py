@@ -79,10 +79,10 @@ def _clicks(true_sk, R, p, views, rng, noise=1.0):
 
 
 @pytest.mark.parametrize("mode", [CALIBRATED, INDEPENDENT])
-@pytest.mark.parametrize("noise", [0.0, 1.0])
-def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, noise):
+@pytest.mark.parametrize("noise, seed", [(0.0, 0), (1.0, 0), (1.0, 5)])
+def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, noise, seed):
     b, guess_sk = _body(cmu_walk)
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(seed)
     true_sk = _scaled(guess_sk, rng)
     R_guess, p_guess = b.frame_pose(590)  # a nearby frame of the walk: the starting guess
     R_true, p_true = _representable(guess_sk, R_guess, *b.frame_pose(600))
@@ -102,12 +102,21 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
             true_sk.offsets[ic]) - 1)
     for left, right in [("LeftKnee", "RightKnee"), ("LeftElbow", "RightElbow")]:
         assert res.lengths[left] == res.lengths[right]  # symmetry holds exactly
-    if noise == 0:  # exact clicks: the fit is exact (independent views: up to one scale,
-        ratio = 1 + np.array(lens)  # each view's own scale takes the body's size)
-        if mode == INDEPENDENT:
-            ratio /= ratio.mean()
+    # the two chest bones meet at no click and no branch, so only their sum shows: one
+    # factor for both (apart, at 1 px noise six seeds of ten pushed one to its 0.5 bound and
+    # the other up by 40-80 %)
+    assert res.lengths["Chest"] == res.lengths["Chest2"]
+    assert all(abs(f - 1) < 0.15 for f in res.lengths.values()), res.lengths
+    if mode == INDEPENDENT:  # the body's size, which the views' scales take, stays about
+        # the guess's: within 3 % over seeds 0-9, whose true bones differ from it by up to
+        # 8 % (with the chest bones apart, seeds 5, 7 and 8 fitted a body 11-16 % taller)
+        assert abs(res.skeleton.height() / guess_sk.height() - 1) < 0.05
+    ratio = 1 + np.array(lens)  # fitted over true lengths
+    if mode == INDEPENDENT:  # each view's own scale takes the body's size: only its
+        ratio /= ratio.mean()  # proportions are fixed by the clicks
+    if noise == 0:  # exact clicks: the fit is exact
         assert np.max(errs) < 0.05 and np.max(np.abs(ratio - 1)) < 1e-3, (errs, lens)
-        assert res.residual_px < 0.01
+        assert res.residual_px < 0.05  # 0.012: the truth's chest bones differ, the fit's not
         return
     # measured at 1 px click noise on a 700-pixel body over seeds 0-9: mean 0.7 (calibrated)
     # and 0.9 (independent) degrees, worst limb 1.2-2.8; the issue asks for every limb within
@@ -115,9 +124,11 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
     # one view while the other two are 30 degrees apart: the click noise carried through the
     # fit (finite differences of the fitted direction in every click coordinate) gives it
     # 1.9 degrees RMS at 1 px, the other limbs 0.4-1.7, so a 2-degree bound on every limb of
-    # every seed is more than these clicks hold
+    # every seed is more than these clicks hold. Lengths over the same seeds: within 1.4 %
+    # (calibrated); independent views fit the body's size freely (0-19 % over) but its
+    # proportions within 1 %
     assert np.mean(errs) < 1.5 and np.max(errs) < 3.0, errs
-    assert np.max(np.abs(lens)) < (0.02 if mode == CALIBRATED else 0.05), lens
+    assert np.max(np.abs(ratio - 1)) < 0.02, lens
     assert res.residual_px < 2
 
 
