@@ -15,7 +15,7 @@ from 0 and backward from 118). Two runs at a time, one per core.
 A window of K frames starts from the capture's pose on its first two frames (the second is
 given as a user's correction: the key frame, and the velocity known) and tracks K more: 15 fps
 forward from every 8th frame and backward from every 8th, 30 fps forward from every 12th
-(36 windows for K = 6). Scored on the tracked frames only, and on each window's last.
+(38 windows for K = 6). Scored on the tracked frames only, and on each window's last.
 """
 
 from __future__ import annotations
