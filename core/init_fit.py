@@ -134,21 +134,16 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
                     [t1, t2, 0.0]) / s), v.center))
         return R, root, offsets, views, factors
 
-    def positions(R, root, offsets):
-        fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites,
-                          limits=sk.limits)
-        return fitted, fitted.world_positions(R, root)
+    # per view, the clicked joints and their clicks (n, 2)
+    clicked_at = [(np.array([sk.index(n) for n in v], dtype=int),
+                   np.array(list(v.values()), dtype=float).reshape(-1, 2)) for v in clicks]
 
     def residuals(x):
         R, root, offsets, views, factors = unpack(x)
-        _, X = positions(R, root, offsets)
-        res = []
-        for v, view_clicks in zip(views, clicks):
-            for name, p in view_clicks.items():
-                res.extend(v.project(X[sk.index(name)]) - np.asarray(p, float))
-        res.extend(PRIOR_ANGLE * x[n_root:n_root + n_dof])
-        res.extend(PRIOR_LENGTH * x[n_root + n_dof:])
-        return np.array(res)
+        X = sk.world_positions(R, root, offsets)
+        res = [(v.project(X[idx]) - pts).ravel() for v, (idx, pts) in zip(views, clicked_at)]
+        res += [PRIOR_ANGLE * x[n_root:n_root + n_dof], PRIOR_LENGTH * x[n_root + n_dof:]]
+        return np.concatenate(res)
 
     x0 = np.zeros(n_root + n_dof + n_len)
     lo = np.full_like(x0, -np.inf)
@@ -160,7 +155,8 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     sol = least_squares(residuals, x0, bounds=(lo, hi), loss="soft_l1", f_scale=3.0,
                         x_scale="jac", ftol=1e-6)
     R, root, offsets, views, factors = unpack(sol.x)
-    fitted, X = positions(R, root, offsets)
+    fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites,
+                      limits=sk.limits)
     fitted.blobs = fitted.default_blobs()
     n_clicks = sum(len(v) for v in clicks)
     rms = float(np.sqrt(np.sum(sol.fun[:2 * n_clicks] ** 2) / max(n_clicks, 1)))

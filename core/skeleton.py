@@ -171,15 +171,18 @@ class Skeleton:
         return self._moved_by
 
     # --- forward kinematics --------------------------------------------------------------
-    def joint_frames(self, rotations: np.ndarray, root_position: np.ndarray) -> np.ndarray:
-        """World frames M_j (J, 4, 4) of every joint for local rotations (J, 3, 3)."""
+    def joint_frames(self, rotations: np.ndarray, root_position: np.ndarray,
+                     offsets: np.ndarray | None = None) -> np.ndarray:
+        """World frames M_j (J, 4, 4) of every joint for local rotations (J, 3, 3); with
+        ``offsets`` (J, 3), of the same hierarchy with those bone offsets instead."""
+        offsets = self.offsets if offsets is None else offsets
         J = self.n_joints
         M = np.empty((J, 4, 4))
         M[0] = se3.rigid(rotations[0], root_position)
         for j in range(1, J):
             p = self.parents[j]
             M[j, :3, :3] = M[p, :3, :3] @ rotations[j]
-            M[j, :3, 3] = M[p, :3, :3] @ self.offsets[j] + M[p, :3, 3]
+            M[j, :3, 3] = M[p, :3, :3] @ offsets[j] + M[p, :3, 3]
             M[j, 3] = (0, 0, 0, 1)
         return M
 
@@ -189,9 +192,10 @@ class Skeleton:
         g[:, :3, 3] -= np.einsum("jab,jb->ja", frames[:, :3, :3], self.rest_positions)
         return g
 
-    def world_positions(self, rotations: np.ndarray, root_position: np.ndarray) -> np.ndarray:
-        """World positions of every joint (J, 3)."""
-        return self.joint_frames(rotations, root_position)[:, :3, 3]
+    def world_positions(self, rotations: np.ndarray, root_position: np.ndarray,
+                        offsets: np.ndarray | None = None) -> np.ndarray:
+        """World positions of every joint (J, 3) (``joint_frames``)."""
+        return self.joint_frames(rotations, root_position, offsets)[:, :3, 3]
 
     # --- blobs ------------------------------------------------------------------------
     def default_blobs(
