@@ -163,7 +163,6 @@ def test_one_view_with_known_lengths_recovers_each_clicked_limb_up_to_its_mirror
     assert mirrored >= 1
 
 
-
 @pytest.mark.parametrize("seed", [0, 3])
 def test_one_view_with_click_noise_recovers_each_limb_in_the_image_plane(cmu_walk, seed):
     # at 1 px noise one view holds each clicked limb's direction in its image plane; its tilt
@@ -189,6 +188,7 @@ def test_one_view_with_click_noise_recovers_each_limb_in_the_image_plane(cmu_wal
             assert turn < 2.0, (a, c, turn)
             checked += 1
     assert checked >= 6
+
 
 def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
     import json
