@@ -31,6 +31,7 @@ from . import silhouette as sil
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from .search import LimbSearch
+from .sequence import ImageSequence
 from .skeleton import HINGE, Skeleton
 from .solver import (
     DegenerateSystem,
@@ -157,46 +158,6 @@ class _Samples:
     sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
     shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
-
-
-class ImageSequence:
-    """Frames of every view, read on demand: ``images[view][frame]`` is a path or an array."""
-
-    def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0):
-        self.images = images
-        self.levels = levels
-        self.highpass = highpass
-        self._cache: dict[tuple[int, int], list[imagelib.Level]] = {}
-        self._grey: dict[tuple[int, int], np.ndarray] = {}
-
-    @property
-    def n_views(self) -> int:
-        return len(self.images)
-
-    def n_frames(self) -> int:
-        return min(len(v) for v in self.images)
-
-    def pyramid(self, view: int, frame: int) -> list[imagelib.Level]:
-        key = (view, frame)
-        if key not in self._cache:
-            self._cache[key] = imagelib.pyramid(self.grey(view, frame), self.levels,
-                                                highpass=self.highpass)
-        return self._cache[key]
-
-    def grey(self, view: int, frame: int) -> np.ndarray:
-        """The full-resolution grey image, unfiltered."""
-        key = (view, frame)
-        if key not in self._grey:
-            src = self.images[view][frame]
-            self._grey[key] = (imagelib.to_grey(src) if isinstance(src, np.ndarray)
-                               else imagelib.load_grey(src))
-        return self._grey[key]
-
-    def keep_only(self, keys: set[tuple[int, int]]) -> None:
-        for cache in (self._cache, self._grey):
-            for k in list(cache):
-                if k not in keys:
-                    del cache[k]
 
 
 class Tracker:
@@ -634,7 +595,9 @@ class Tracker:
         yield first
         history = [first]
         residuals: list[float] = []
-        for frame in frames[1:]:
+        for i, frame in enumerate(frames[1:], 1):
+            if i + 1 < len(frames):
+                self.seq.read_ahead(frames[i + 1])
             prev = history[-1]
             if frame in corrections:
                 key_frame, key = frame, corrections[frame].copy()

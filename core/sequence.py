@@ -1,0 +1,86 @@
+"""Every view's frames, read on demand and kept while they are needed; the next frame is
+read ahead on a worker thread while the current one is tracked.
+
+Reading a frame (decoding the file, building its pyramid) is OpenCV work that releases the
+interpreter's lock, so it runs beside the tracker's own on the machine's other core. A frame
+read ahead gives the same arrays as one read when asked for, and a file that cannot be read
+raises its ``ImageError`` when its frame is asked for, not when it is read ahead.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+
+import numpy as np
+
+from . import image as imagelib
+
+
+class ImageSequence:
+    """``images[view][frame]`` is a path or an array; grey images are float32 (H, W) in
+    [0, 1], pyramids finest level first (``core.image.pyramid``)."""
+
+    def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0):
+        self.images = images
+        self.levels = levels
+        self.highpass = highpass
+        self._pyramids: dict[tuple[int, int], list[imagelib.Level]] = {}  # (view, frame)
+        self._grey: dict[tuple[int, int], np.ndarray] = {}
+        self._ahead: dict[int, Future] = {}  # frame -> per view (grey, pyramid)
+        self._reader = ThreadPoolExecutor(max_workers=1, thread_name_prefix="twist-read")
+
+    @property
+    def n_views(self) -> int:
+        return len(self.images)
+
+    def n_frames(self) -> int:
+        return min(len(v) for v in self.images)
+
+    def pyramid(self, view: int, frame: int) -> list[imagelib.Level]:
+        key = (view, frame)
+        if key not in self._pyramids:
+            self._collect(frame)
+        if key not in self._pyramids:
+            self._pyramids[key] = self._build(self.grey(view, frame))
+        return self._pyramids[key]
+
+    def grey(self, view: int, frame: int) -> np.ndarray:
+        """The full-resolution grey image, unfiltered."""
+        key = (view, frame)
+        if key not in self._grey:
+            self._collect(frame)
+        if key not in self._grey:
+            self._grey[key] = self._read(view, frame)
+        return self._grey[key]
+
+    def read_ahead(self, frame: int) -> None:
+        """Start reading every view's ``frame`` and building its pyramids in the background."""
+        if frame in self._ahead or all((c, frame) in self._pyramids
+                                       for c in range(self.n_views)):
+            return
+        self._ahead[frame] = self._reader.submit(
+            lambda: [(g, self._build(g)) for g in
+                     (self._read(c, frame) for c in range(self.n_views))])
+
+    def keep_only(self, keys: set[tuple[int, int]]) -> None:
+        """Forget every (view, frame) not in ``keys``; frames being read ahead stay."""
+        for cache in (self._pyramids, self._grey):
+            for k in list(cache):
+                if k not in keys:
+                    del cache[k]
+
+    def _collect(self, frame: int) -> None:
+        """Take a frame read ahead into the caches (waiting for it if need be)."""
+        if frame not in self._ahead:
+            return
+        for c, (grey, pyr) in enumerate(self._ahead.pop(frame).result()):
+            self._grey.setdefault((c, frame), grey)
+            self._pyramids.setdefault((c, frame), pyr)
+
+    def _read(self, view: int, frame: int) -> np.ndarray:
+        src = self.images[view][frame]
+        return imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
+
+    def _build(self, grey: np.ndarray) -> list[imagelib.Level]:
+        return imagelib.pyramid(grey, self.levels, highpass=self.highpass)

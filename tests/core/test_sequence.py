@@ -1,0 +1,51 @@
+"""Frames read ahead on the worker thread are the frames read when asked for."""
+
+import cv2
+import numpy as np
+import pytest
+
+from core.image import ImageError
+from core.sequence import ImageSequence
+
+
+@pytest.fixture
+def footage(tmp_path):
+    """Two views of three textured 60x80 frames as PNG files: paths[view][frame]."""
+    rng = np.random.default_rng(3)
+    paths = []
+    for c in range(2):
+        paths.append([])
+        for f in range(3):
+            p = tmp_path / f"view{c}_{f:02d}.png"
+            cv2.imwrite(str(p), rng.integers(0, 256, (60, 80, 3), dtype=np.uint8))
+            paths[-1].append(p)
+    return paths
+
+
+def test_a_frame_read_ahead_is_the_frame_read_when_asked(footage):
+    ahead, plain = (ImageSequence(footage, 3, highpass=4.0) for _ in range(2))
+    ahead.read_ahead(1)
+    for c in range(2):
+        np.testing.assert_array_equal(ahead.grey(c, 1), plain.grey(c, 1))
+        for a, b in zip(ahead.pyramid(c, 1), plain.pyramid(c, 1), strict=True):
+            np.testing.assert_array_equal(a.stack, b.stack)
+            assert a.scale == b.scale
+
+
+def test_a_frame_read_ahead_survives_its_file_and_the_cache_trim(footage):
+    seq = ImageSequence(footage, 2)
+    seq.read_ahead(2)
+    seq._ahead[2].result()  # read: the files are no longer needed
+    for c in range(2):
+        footage[c][2].unlink()
+    seq.keep_only(set())
+    assert seq.pyramid(1, 2)[1].shape == (30, 40)
+
+
+def test_an_unreadable_frame_read_ahead_fails_when_asked_for_naming_its_file(footage):
+    footage[1][2].write_bytes(b"not a png")
+    seq = ImageSequence(footage, 2)
+    seq.read_ahead(2)  # no error yet: the frame may never be asked for
+    seq.pyramid(0, 1)
+    with pytest.raises(ImageError, match="view1_02.png"):
+        seq.pyramid(0, 2)
