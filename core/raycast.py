@@ -29,34 +29,61 @@ class Hits:
     rim: np.ndarray
 
 
-def _posed(blobs: list[Ellipsoid], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class BlobStack:
+    """Every blob's fixed numbers stacked, to pose and cast them many times: the joint whose
+    segment carries it (E,), and in that segment's reference frame its centre (E, 3), axes Q
+    (E, 3, 3, as columns), radii (E, 3) and Q diag(1/r) (E, 3, 3)."""
+
+    joint: np.ndarray
+    centre: np.ndarray
+    Q: np.ndarray
+    radii: np.ndarray
+    to_unit: np.ndarray
+
+    @classmethod
+    def of(cls, blobs: list[Ellipsoid] | BlobStack) -> BlobStack:
+        if isinstance(blobs, BlobStack):
+            return blobs
+        E = len(blobs)
+        return cls(np.array([b.joint for b in blobs], dtype=int),
+                   np.array([b.centre for b in blobs], dtype=float).reshape(E, 3),
+                   np.array([b.Q for b in blobs], dtype=float).reshape(E, 3, 3),
+                   np.array([b.radii for b in blobs], dtype=float).reshape(E, 3),
+                   np.array([b.Q / b.radii for b in blobs], dtype=float).reshape(E, 3, 3))
+
+    def __len__(self) -> int:
+        return len(self.joint)
+
+
+def _posed(blobs: BlobStack, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per blob, its segment's world rotation (E, 3, 3) and its world centre (E, 3)."""
-    joints = np.array([b.joint for b in blobs], dtype=int)
-    R, p = g[joints, :3, :3], g[joints, :3, 3]
-    centres = np.array([b.centre for b in blobs]).reshape(-1, 3)
-    return R, np.einsum("eab,eb->ea", R, centres) + p
+    R, p = g[blobs.joint, :3, :3], g[blobs.joint, :3, 3]
+    return R, np.einsum("eab,eb->ea", R, blobs.centre) + p
 
 
-def blob_frames(blobs: list[Ellipsoid], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def blob_frames(blobs: list[Ellipsoid] | BlobStack, g: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Per blob, world-to-normalised linear map (E, 3, 3) and world centre (E, 3).
 
     g: (J, 4, 4) segment motions, reference frame to world.
     """
+    blobs = BlobStack.of(blobs)
     R, C = _posed(blobs, g)
     return _to_unit(blobs, R), C
 
 
-def _to_unit(blobs: list[Ellipsoid], R: np.ndarray) -> np.ndarray:
+def _to_unit(blobs: BlobStack, R: np.ndarray) -> np.ndarray:
     """World-to-normalised maps (E, 3, 3) of blobs whose segments turn by R (E, 3, 3)."""
-    to_unit = np.array([b.Q / b.radii for b in blobs]).reshape(-1, 3, 3)  # Q diag(1 / r)
-    return np.einsum("eba,ecb->eac", to_unit, R)  # (Q diag(1 / r))^T R^T
+    return np.einsum("eba,ecb->eac", blobs.to_unit, R)  # (Q diag(1 / r))^T R^T
 
 
-def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid], g: np.ndarray) -> Hits:
+def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray
+         ) -> Hits:
     """Nearest blob hit for each pixel (N, 2) in the view, blobs posed by segment motions g."""
     origin, d = view.ray(pixels)
     N = len(pixels)
-    if not blobs:
+    if not len(blobs):
         return Hits(np.full(N, -1), np.full(N, np.inf), np.zeros((N, 3)), np.zeros(N))
     A, C = blob_frames(blobs, g)
     e = A @ d  # (E, 3)
@@ -77,18 +104,17 @@ def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid], g: np.ndarray) 
     return Hits(label, depth, world, np.clip(rim, 0.0, 1.0))
 
 
-def blob_boxes(view: View, blobs: list[Ellipsoid], g: np.ndarray) -> np.ndarray:
+def blob_boxes(view: View, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray) -> np.ndarray:
     """Pixel extents (E, 4) = (xmin, ymin, xmax, ymax) of every blob's outline, as floats.
 
     An ellipsoid's half extent along image axis i is |row i of s R_cam R_seg Q diag(r)|."""
+    blobs = BlobStack.of(blobs)
     return _boxes(view, blobs, *_posed(blobs, g))
 
 
-def _boxes(view: View, blobs: list[Ellipsoid], Rs: np.ndarray, centres: np.ndarray
-           ) -> np.ndarray:
+def _boxes(view: View, blobs: BlobStack, Rs: np.ndarray, centres: np.ndarray) -> np.ndarray:
     """``blob_boxes`` of blobs posed by ``_posed``."""
-    axes = np.einsum("eab,ebc->eac", Rs, np.array([b.Q for b in blobs]))
-    axes = axes * np.array([b.radii for b in blobs])[:, None, :]
+    axes = np.einsum("eab,ebc->eac", Rs, blobs.Q) * blobs.radii[:, None, :]
     M = view.pose.s * np.einsum("ab,ebc->eac", view.pose.R[:2], axes)
     half = np.linalg.norm(M, axis=2)
     c = view.project(centres)
@@ -102,16 +128,18 @@ def _clip_box(lo, hi, shape, margin: int):
     return None if x0 >= x1 or y0 >= y1 else (x0, y0, x1, y1)
 
 
-def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarray, Hits, tuple]:
+def render_labels(view: View, blobs: list[Ellipsoid] | BlobStack, g, shape, step: int = 1
+                  ) -> tuple[np.ndarray, Hits, tuple]:
     """Z-buffer the pixels of the silhouette box whose coordinates are multiples of ``step``,
     over every blob's own box at once; returns the covered pixels (N, 2), their hits and
     the box (None if nothing shows).
 
     Same result as :func:`cast` on those pixels, at a fraction of the work: under orthography
     the ray's start is affine in the pixel, so each blob's quadratic is evaluated on its box."""
+    blobs = BlobStack.of(blobs)
     Rs, C = _posed(blobs, g)  # once, for the boxes and the blobs' normalised frames
-    boxes = _boxes(view, blobs, Rs, C) if blobs else np.zeros((0, 4))
-    box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if blobs else None
+    boxes = _boxes(view, blobs, Rs, C) if len(blobs) else np.zeros((0, 4))
+    box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if len(blobs) else None
     if box is None:
         empty = np.zeros((0, 2))
         return empty, cast(view, empty, blobs, g), None
@@ -121,13 +149,13 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     ys = np.arange(y0, y1, step, dtype=float)
     depth = np.full((len(ys), len(xs)), np.inf)
     A = _to_unit(blobs, Rs)
-    o00, d = view.ray(np.array([[0.0, 0.0]]))
-    ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00[0]  # world step of the ray start per pixel
-    oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00[0]
+    (o00,), d = view.ray(np.array([[0.0, 0.0]]))
+    ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00  # world step of the ray start per pixel
+    oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00
     # w(u, v) = w0 + u wx + v wy in each blob's normalised frame, so b = w.e is affine and
     # disc = b^2 - a (|w|^2 - 1) quadratic in the pixel: all coefficients per blob up front
     e = A @ d  # (E, 3)
-    w0 = np.einsum("eab,eb->ea", A, o00[0] - C)
+    w0 = np.einsum("eab,eb->ea", A, o00 - C)
     wx, wy = A @ ox, A @ oy
     a = np.sum(e * e, 1)
     b0, bx, by = (np.sum(w * e, 1) for w in (w0, wx, wy))
@@ -181,7 +209,7 @@ def render_labels(view: View, blobs, g, shape, step: int = 1) -> tuple[np.ndarra
     pixels = np.stack([xs[uu], ys[vv]], 1)
     dep = depth[vv, uu]
     lab = label[vv, uu]
-    origin = o00[0] + pixels[:, :1] * ox + pixels[:, 1:] * oy
+    origin = o00 + pixels[:, :1] * ox + pixels[:, 1:] * oy
     hits = Hits(lab, dep, origin + dep[:, None] * d, np.minimum(disc_front[vv, uu] * a[lab], 1.0))
     return pixels, hits, box
 

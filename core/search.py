@@ -28,7 +28,7 @@ from . import se3
 from .camera import View
 from .linearize import Kinematics
 from .pose import BodyPose
-from .raycast import blob_frames, shadows
+from .raycast import BlobStack, blob_frames, shadows
 from .skeleton import BALL, HINGE, Skeleton
 
 SWING = (np.arange(-60, 61, 15), np.arange(-10, 11, 5))  # coarse grid, then around the best
@@ -120,7 +120,8 @@ class LimbSearch:
         self.sk = skeleton
         self.margin = margin
         moved = skeleton.moved_by()  # [m, j]: j moves m
-        blob_joint = np.array([b.joint for b in skeleton.blobs], dtype=int)
+        self.blobs = BlobStack.of(skeleton.blobs)
+        blob_joint = self.blobs.joint
         tracked = [j for j in range(1, skeleton.n_joints) if skeleton.kinds[j] in (BALL, HINGE)]
         self.limbs: list[_Limb] = []
         for j in tracked:
@@ -149,7 +150,7 @@ class LimbSearch:
         cannot tell a limb turned toward the camera from a shorter one."""
         pose = pose.copy()
         kin = Kinematics(self.sk, pose)
-        A, C = blob_frames(self.sk.blobs, kin.segments)
+        A, C = blob_frames(self.blobs, kin.segments)
         fgs = [None if fg is None or self._foreground_share(view, fg, A, C) < MIN_FOREGROUND
                else fg for view, fg in zip(views, fgs)]
         n_views = sum(fg is not None for fg in fgs)
@@ -162,14 +163,14 @@ class LimbSearch:
                                                       @ axis) < SIDE_ON):
                     continue
                 limb = _Limb(limb.joint, limb.own, limb.below, limb.dofs[-1:])
-            rest = np.setdiff1d(np.arange(len(self.sk.blobs)), limb.below)
+            rest = np.setdiff1d(np.arange(len(self.blobs)), limb.below)
             angles = self._best(limb, kin, A, C, rest, views, fgs)
             if angles is not None:
                 for (j, axis, _), a in zip(limb.dofs, angles):
                     pose.rotations[j] = pose.rotations[j] @ se3.exp_so3(axis * np.radians(a))
                 turned.append(self.sk.names[limb.joint])
                 kin = Kinematics(self.sk, pose)  # the limbs below see it turned
-                A, C = blob_frames(self.sk.blobs, kin.segments)
+                A, C = blob_frames(self.blobs, kin.segments)
         return pose, turned
 
     @staticmethod
@@ -219,8 +220,9 @@ class LimbSearch:
             cands = cands[self._allowed(limb, kin.pose, cands)]
             Rw = np.broadcast_to(np.eye(3), (len(cands), 3, 3))
             for i, (j, axis, _) in enumerate(limb.dofs):  # parents first: a world rotation each
-                W = kin.frames[j, :3, :3]
-                Rw = Rw @ se3.exp_so3(np.radians(cands[:, i, None]) * (W @ axis))
+                angles, which = np.unique(cands[:, i], return_inverse=True)  # a grid's few
+                turns = se3.exp_so3(np.radians(angles[:, None]) * (kin.frames[j, :3, :3] @ axis))
+                Rw = Rw @ turns[which]
             Ck = np.einsum("kab,eb->kea", Rw, C[limb.own] - pivot) + pivot
             Ak = np.einsum("eab,kcb->keac", A[limb.own], Rw)
             cost = np.zeros(len(cands))

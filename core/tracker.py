@@ -179,18 +179,17 @@ class Tracker:
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
-        self.n_dof = len(skeleton.dof_joints_and_axes()[0])
+        self._dof_joint = skeleton.dof_joints_and_axes()[0]
+        self.n_dof = len(self._dof_joint)
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
         # thinnest blob each degree of freedom turns directly, world units (inf: none)
         thin = np.full(skeleton.n_joints, np.inf)
         for b in skeleton.blobs:
             thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
-        self._dof_joint = skeleton.dof_joints_and_axes()[0]
         self.dof_thickness = thin[self._dof_joint]
-        self._blob_joints = np.array([b.joint for b in skeleton.blobs], dtype=int)
+        self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are when tracking starts
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
-        self._blob_centres = np.array([b.centre for b in skeleton.blobs])
         self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
         self.notes: list[str] = []  # what the user should know about the run
         self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
@@ -212,7 +211,7 @@ class Tracker:
                 out.append(None)
                 continue
             shape = self.seq.pyramid(c, frame)[lv].shape
-            boxes = raycast.blob_boxes(est.views[c].at_level(lv), self.skeleton.blobs,
+            boxes = raycast.blob_boxes(est.views[c].at_level(lv), self._blobs,
                                        kin.segments)
             # on the label map's grid (every g-th level pixel)
             x0, y0 = np.maximum(np.floor((boxes[:, :2].min(0) - margin) / g), 0).astype(int)
@@ -302,11 +301,11 @@ class Tracker:
         step = self.settings.pixel_step if lv == 0 else 1
         v_l = pose.views[view].at_level(lv)
         pix_l, hits, _ = raycast.render_labels(
-            v_l, self.skeleton.blobs, kin.segments, level.shape, step
+            v_l, self._blobs, kin.segments, level.shape, step
         )
         ok = hits.label >= 0
         pix_l, label = pix_l[ok].astype(int), hits.label[ok]
-        seg_joint = self._blob_joints[label]
+        seg_joint = self._blobs.joint[label]
         g = kin.segments[seg_joint]
         d = hits.world[ok] - g[:, :3, 3]
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
@@ -319,7 +318,7 @@ class Tracker:
         """Front-most blob (-1: none) at every ``grid``-th level pixel, as a map whose pixel
         (i, j) is level pixel (grid i, grid j), and per map pixel the index of its hit."""
         v_l = pose.views[view].at_level(lv)
-        pix, hits, box = raycast.render_labels(v_l, self.skeleton.blobs, kin.segments, shape,
+        pix, hits, box = raycast.render_labels(v_l, self._blobs, kin.segments, shape,
                                                grid)
         size = (-(-shape[0] // grid), -(-shape[1] // grid))
         lab = np.full(size, -1, dtype=np.int32)
@@ -359,7 +358,7 @@ class Tracker:
                 mm.model += (x0, y0)
                 mm.target += (x0, y0)
                 h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
-                shape_parts.append((self._blob_joints[hits.label[h]], hits.world[h],
+                shape_parts.append((self._blobs.joint[hits.label[h]], hits.world[h],
                                     mm.target * (2**lv * g), mm.weight))
         measured = []
         for k, ps in enumerate(sets):
@@ -471,7 +470,7 @@ class Tracker:
 
     def _blob_pixels(self, kin: Kinematics) -> np.ndarray:
         """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
-        centres = kin.world_points(self._blob_joints, self._blob_centres)
+        centres = kin.world_points(self._blobs.joint, self._blobs.centre)
         return np.array([v.project(centres) for v in kin.pose.views])
 
     def frame_pixels(self, prev: BodyPose, prev_frame: int, est: BodyPose, frame: int
