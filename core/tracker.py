@@ -28,6 +28,7 @@ import numpy as np
 from . import image as imagelib
 from . import raycast
 from . import silhouette as sil
+from .blas import one_blas_thread
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from .search import LimbSearch
@@ -611,7 +612,8 @@ class Tracker:
             else:
                 pred = prev.pose.copy()
             try:
-                res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
+                with one_blas_thread():
+                    res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
             except DegenerateSystem as e:
                 res = FrameResult(frame, pred, float("nan"), 0, False, True, str(e))
             if not res.diverged:
