@@ -52,8 +52,6 @@ def apply_update(
 ) -> BodyPose:
     """The pose moved by the parameter step ``delta`` (root block(s) then joint DOFs)."""
     new = pose.copy()
-    frames = skeleton.joint_frames(pose.rotations, pose.root_position)
-    root_world = frames[0, :3, 3]
     nr = n_root_params(mode, len(pose.views))
     if mode == CALIBRATED:
         dv, dw = delta[:3], delta[3:6]
@@ -65,7 +63,7 @@ def apply_update(
             ds, dv1, dv2 = delta[6 * c : 6 * c + 3]
             E = se3.exp_so3(delta[6 * c + 3 : 6 * c + 6])
             P = view.pose
-            q_r = P.apply(root_world)
+            q_r = P.apply(np.asarray(pose.root_position, dtype=float))
             s_new = P.s * (1 + ds)
             R_new = E @ P.R
             t_new = E @ P.t + (q_r + np.array([dv1, dv2, 0.0]) - (1 + ds) * (E @ q_r)) / s_new
