@@ -2,11 +2,13 @@
 
 ``VideoFrames(path)[i]`` is frame i (0-based) as an array (height, width, 3) in BGR order, the
 same as ``cv2.imread`` gives for an image, so the tracker takes a movie wherever it takes a list
-of image files. Reading forward is sequential decoding; a jump seeks.
+of image files. Reading forward is sequential decoding; a jump seeks. One decoder serves one
+reader at a time: the tracker reads the next frame ahead on a thread of its own.
 """
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import cv2
@@ -32,6 +34,7 @@ class VideoFrames:
                              "OpenCV cannot decode; convert it to MP4 or an image sequence)")
         self._count = int(self._cap.get(cv2.CAP_PROP_FRAME_COUNT))
         self._next = 0
+        self._lock = threading.Lock()  # a seek and its read go together
 
     def __len__(self) -> int:
         return self._count
@@ -39,12 +42,13 @@ class VideoFrames:
     def __getitem__(self, i: int) -> np.ndarray:
         if not 0 <= i < self._count:
             raise IndexError(f"{self.path}: frame {i} is outside 0..{self._count - 1}")
-        if i != self._next:
-            self._cap.set(cv2.CAP_PROP_POS_FRAMES, i)
-        ok, frame = self._cap.read()
+        with self._lock:
+            if i != self._next:
+                self._cap.set(cv2.CAP_PROP_POS_FRAMES, i)
+            ok, frame = self._cap.read()
+            self._next = i + 1 if ok else -1
         if not ok:
             raise ImageError(f"{self.path}: frame {i} cannot be decoded")
-        self._next = i + 1
         return frame
 
     def select(self, indices: list[int]) -> Selection:

@@ -49,3 +49,24 @@ def test_an_unreadable_frame_read_ahead_fails_when_asked_for_naming_its_file(foo
     seq.pyramid(0, 1)
     with pytest.raises(ImageError, match="view1_02.png"):
         seq.pyramid(0, 2)
+
+
+def test_a_movie_read_from_two_threads_gives_each_its_own_frame(footage, tmp_path):
+    """The read-ahead thread and the tracker's thread share one decoder: each seek must stay
+    with its read (without the decoder's lock, frames came back corrupt or from elsewhere)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from core.video import VideoFrames
+
+    movie = tmp_path / "view0.avi"
+    writer = cv2.VideoWriter(str(movie), cv2.VideoWriter_fourcc(*"MJPG"), 30, (80, 60))
+    for p in footage[0]:
+        writer.write(cv2.imread(str(p)))
+    writer.release()
+    video = VideoFrames(movie)
+    once = [video[i] for i in range(3)]
+    order = [2, 0, 1, 1, 2, 0] * 20
+    with ThreadPoolExecutor(2) as pool:
+        got = list(pool.map(lambda i: (i, video[i]), order))
+    for i, frame in got:
+        np.testing.assert_array_equal(frame, once[i])
