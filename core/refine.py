@@ -36,6 +36,8 @@ from .skeleton import BALL, HINGE, Skeleton
 from .solver import NormalEquations, solve
 from .tracker import Tracker, TrackerSettings, track
 
+REFINE_ITERATIONS = 4  # Gauss-Newton iterations a level, at least, on the tracks it reads
+
 
 class RefineError(ValueError):
     """A refinement that cannot be made; the message says why."""
@@ -198,8 +200,12 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
     sk, pose = skeleton, initial
     # tracked without the limb search: fitting each limb's outline to the wrong joint, it
     # soaked up the mismatch the refinement reads (a knee 4 cm off stayed 3.9 cm off, 1.4
-    # without it, in the add-on's test)
-    settings = dataclasses.replace(settings or TrackerSettings(), limb_search=0.0)
+    # without it, in the add-on's test); and with REFINE_ITERATIONS a level at least, since
+    # the refinement reads what converged steps leave (with three, the planar chain's test
+    # diverged at its last frame)
+    settings = settings or TrackerSettings()
+    settings = dataclasses.replace(settings, limb_search=0.0,
+                                   iterations=max(settings.iterations, REFINE_ITERATIONS))
     idx = []
     for name in joints:
         if name not in sk.names:
