@@ -100,11 +100,11 @@ def _paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tupl
     mask |= np.cumsum(edges[:, :-1], axis=1) > 0
 
 
-def _sums(c, half, P, box, S: np.ndarray) -> np.ndarray:
-    """Per candidate (K, B blobs each): the sum over its outline (the union of its blobs'
-    ellipses) of the box image whose row prefix sums are S (rows, cols + 1). Overlaps of two
-    ellipses are taken out once; a pixel under three of one candidate's is counted twice."""
-    lo, hi = _spans(c, half, P, box)  # (K, B, rows)
+def _sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """Per candidate (K, B blobs each, spans (K, B, rows) from ``_spans``): the sum over its
+    outline (the union of its blobs' ellipses) of the box image whose row prefix sums are S
+    (rows, cols + 1). Overlaps of two ellipses are taken out once; a pixel under three of one
+    candidate's is counted twice."""
     rows = np.arange(S.shape[0])
     total = np.sum(S[rows, hi] - S[rows, lo], axis=(1, 2))
     for i, k in itertools.combinations(range(lo.shape[1]), 2):
@@ -238,11 +238,11 @@ class LimbSearch:
                 if v not in sums or not _inside(box, sums[v][0]):
                     sums[v] = box, self._gain_sums(view, fg, A[rest], C[rest], box)
                 box, S = sums[v]
-                cost += _sums(c, half, P, box, S)
-                if stage == 0:
-                    ones = np.zeros_like(S)
-                    ones[:, 1:] = np.arange(1, S.shape[1])
-                    area += float(_sums(c[:1], half[:1], P[:1], box, ones)[0])
+                lo, hi = _spans(c, half, P, box)
+                cost += _sums(lo, hi, S)
+                if stage == 0:  # the current pose's outline: the sum of a ramp's increments
+                    ramp = np.broadcast_to(np.arange(S.shape[1], dtype=float), S.shape)
+                    area += float(_sums(lo[:1], hi[:1], ramp)[0])
             if stage == 0:
                 current = cost[0]
             best = cands[int(np.argmin(cost))]

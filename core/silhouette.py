@@ -113,10 +113,8 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
         _, nearest = cv2.distanceTransformWithLabels(
             (~near_mask).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5,
             labelType=cv2.DIST_LABEL_PIXEL)
-        ny, nx = np.nonzero(near_mask)
         ys, xs = np.nonzero(src)
-        k = nearest[ys, xs] - 1
-        iy, ix = ny[k], nx[k]
+        iy, ix = np.divmod(np.flatnonzero(near_mask)[nearest[ys, xs] - 1], near_mask.shape[1])
         dist = np.hypot(iy - ys, ix - xs)
         cost += w * float(np.sum(np.maximum(np.minimum(dist, cap) - slack, 0) ** 2))
         keep = (dist <= cap) & (dist > slack)

@@ -6,7 +6,7 @@ import numpy as np
 from core import raycast, se3
 from core.linearize import Kinematics
 from core.pose import INDEPENDENT, BodyPose, apply_update
-from core.search import LimbSearch, _outlines, _paint, _sums
+from core.search import LimbSearch, _outlines, _paint, _spans, _sums
 from core.skeleton import human_template
 from support.synthetic import side_view
 
@@ -62,8 +62,11 @@ def test_outline_sums_count_each_pixel_of_overlapping_blobs_once():
             _paint(one, view, A[pair[:1]], C[pair[:1]], box)
             _paint(other, view, A[pair[1:]], C[pair[1:]], box)
             assert union.sum() < one.sum() + other.sum()  # they overlap
-            np.testing.assert_allclose(_sums(c, half, P, box, S)[0], img[union].sum(),
-                                       atol=1e-9)
+            lo, hi = _spans(c, half, P, box)
+            np.testing.assert_allclose(_sums(lo, hi, S)[0], img[union].sum(), atol=1e-9)
+            # a ramp's increments count the outline's pixels: its area, as the search takes it
+            ramp = np.broadcast_to(np.arange(BODY[1] + 1, dtype=float), S.shape)
+            assert _sums(lo, hi, ramp)[0] == union.sum()
 
 
 def _foreground(sk, pose, view):
