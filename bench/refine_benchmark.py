@@ -64,6 +64,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
+    if not 0 <= a.first < a.last - 2 or a.last > len(info["frames"]):
+        ap.error(f"--first {a.first} --last {a.last}: the footage has frames 0-"
+                 f"{len(info['frames']) - 1}; give at least three, with --last one past them")
     views, mode, _ = RUNS["3 views calibrated 30 fps"]
     job = load_job(write_job(a.cache, "refine", views, mode, info["frames"], info["cameras"],
                              {}, 4 / 120))
