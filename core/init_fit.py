@@ -73,7 +73,7 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     # be (one common factor for them left the upper arms 2 degrees off with exact clicks);
     # bones below every click scale with one common factor, so that they do not soak up noise
     clicked = {sk.index(n) for v in clicks for n in v}
-    below = {a for c in clicked for a in sk.ancestors(c)}
+    on_path = {a for c in clicked for a in sk.ancestors(c)}  # clicked joints and above
 
     def chain_start(j: int) -> int:
         """The first joint of the unbranched run of bones that ends at j: bones meeting at a
@@ -85,7 +85,7 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
         return j
 
     def group_key(j: int) -> str:
-        return symmetry_key(sk.names[chain_start(j)]) if j in below else "*body"
+        return symmetry_key(sk.names[chain_start(j)]) if j in on_path else "*body"
 
     bones = [j for j in range(1, sk.n_joints) if np.linalg.norm(sk.offsets[j]) > 1e-9]
     groups = sorted({group_key(j) for j in bones})
@@ -96,9 +96,8 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     # what clicked joint positions can pin down: the root, and per joint with a clicked joint
     # below it its swing (a ball's twist about its bone moves no joint on the bone); lengths
     # lean on their prior and bounds
-    below = {a for n in (name for v in clicks for name in v)
-             for a in sk.ancestors(sk.index(n))[1:]}
-    swings = sum(2 if sk.kinds[j] == BALL else 1 for j in joints if j in below)
+    above_click = {a for c in clicked for a in sk.ancestors(c)[1:]}
+    swings = sum(2 if sk.kinds[j] == BALL else 1 for j in joints if j in above_click)
     _check(sk, clicks, n_root + swings)
     if fit_lengths and len(clicks) == 1:
         raise FitError("one view cannot tell a longer bone from one turned out of the image "
