@@ -30,6 +30,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from . import se3
+from .blas import one_blas_thread
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, BodyPose
 from .skeleton import BALL, HINGE, Skeleton
@@ -231,7 +232,8 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
         poses = [f.pose for f in result.frames]
         shifts, turns, new = {}, {}, sk
         for j in idx:
-            W = segment_twists(tracker, poses, frames, j, planar)
+            with one_blas_thread():  # the same sums in the same order on any machine
+                W = segment_twists(tracker, poses, frames, j, planar)
             if sk.kinds[j] == HINGE:
                 # a hinge turns about R_j a in the frame before its rotation (R_j = R_j(0)
                 # exp(theta a)), so the axis found there is taken back through R_j(0)

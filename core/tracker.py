@@ -188,7 +188,7 @@ class Tracker:
         for b in skeleton.blobs:
             thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
         self.dof_thickness = thin[self._dof_joint]
-        self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are when tracking starts
+        self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are now, stacked
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
         self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
