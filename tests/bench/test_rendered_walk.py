@@ -54,10 +54,8 @@ def test_rendered_walk_tracks_its_legs_and_neck(walk, tmp_path):
 TRACK_AND_PRINT = """
 import sys, hashlib, numpy as np
 from core.job import load_job
-from core.tracker import Tracker, track
-job = load_job(sys.argv[1])
-res = track(Tracker(job.skeleton, job.images, job.mode, job.settings), job.initial,
-            range(len(job.images[0])))
+from core.run import run_job
+res = run_job(load_job(sys.argv[1]))
 poses = np.array([np.concatenate([f.pose.rotations.ravel(), f.pose.root_position])
                   for f in res.frames])
 print(hashlib.sha256(poses.tobytes()).hexdigest())
