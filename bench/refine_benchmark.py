@@ -2,10 +2,12 @@
 with a skeleton whose left knee sits 4 cm forward of the capture's and whose right knee axis
 is turned 15 degrees, refined (core.refine), and scored before and after.
 
-    python bench/refine_benchmark.py [--cache .cache/walk] [--first 60] [--last 90]
+    python bench/refine_benchmark.py [--cache .cache/walk] [--first 60] [--last 119]
+                                     [--rounds 10]
 
-Frames are indices into the 30 fps footage (the default stretch is steady walking). Prints
-each refined joint's centre and axis error against the capture's skeleton and the legs'
+Frames are indices into the 30 fps footage (the default stretch is its steady walking, to
+the end); the refinement runs until the joints settle or ``--rounds`` are done. Prints each
+refined joint's centre and axis error against the capture's skeleton and the legs'
 limb-direction errors when tracked with the skeleton before and after refinement.
 """
 
@@ -59,11 +61,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
     ap.add_argument("--first", type=int, default=60)
-    ap.add_argument("--last", type=int, default=90)
-    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--last", type=int, help="one past the last frame (default: the end)")
+    ap.add_argument("--rounds", type=int, default=10, help="track-and-refine rounds, at most")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
+    a.last = len(info["frames"]) if a.last is None else a.last
     if not 0 <= a.first < a.last - 2 or a.last > len(info["frames"]):
         ap.error(f"--first {a.first} --last {a.last}: the footage has frames 0-"
                  f"{len(info['frames']) - 1}; give at least three, with --last one past them")
@@ -83,11 +86,12 @@ def main(argv=None) -> int:
     guess = moved_joint(moved_joint(truth_sk, lk, np.array([0.0, 0.0, 0.04])), rk,
                         np.zeros(3), turned)
     initial = carried_pose(truth_sk, guess, initial_true)  # lined up, centres wrong
-    result = refine(guess, images, initial, ["LeftKnee", "RightKnee"], rounds=a.rounds,
-                    tolerance=0.0)
+    result = refine(guess, images, initial, ["LeftKnee", "RightKnee"], rounds=a.rounds)
     refined = result.skeleton
 
-    print(f"frames {a.first}-{a.last - 1} of the 30 fps footage, {a.rounds} rounds\n")
+    settled = "settled" if result.settled() else "not settled"
+    print(f"frames {a.first}-{a.last - 1} of the 30 fps footage, {len(result.shifts)} rounds"
+          f" ({settled})\n")
     print("| joint | centre error before | after | axis error before | after | after, against"
           " the capture's own axis |")
     print("|---|---|---|---|---|---|")

@@ -9,6 +9,7 @@ from core import se3
 from core.pose import CALIBRATED, BodyPose
 from core.refine import (
     RefineError,
+    Refinement,
     carried_pose,
     centre_from_twists,
     hinge_from_twists,
@@ -111,6 +112,23 @@ def _human_walk(T=8):
     images = [[render(sk, p, c, background=0.05, noise=0.01, seed=t)
                for t, p in enumerate(poses)] for c in range(3)]
     return sk, poses, images
+
+
+def test_a_round_settles_only_when_no_joint_moves_and_no_axis_turns():
+    sk = human_template()
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3), [side_view()])
+    res = Refinement(sk, pose)
+    assert not res.settled()  # no round yet
+    res.shifts.append({"LeftKnee": 5e-4, "LeftHip": 2e-4})
+    res.turns.append({"LeftKnee": 2.0})  # the centres are still, the axis is not
+    assert not res.settled()
+    assert res.settled(turn_tolerance=3.0)
+    res.turns[-1]["LeftKnee"] = 0.2
+    assert res.settled()
+    res.shifts.append({"LeftHip": 2e-3})  # a round of ball joints only: no axis to turn
+    res.turns.append({})
+    assert not res.settled()
+    assert res.settled(tolerance=3e-3)
 
 
 def test_twists_estimated_from_footage_match_the_true_skeleton():
