@@ -92,13 +92,35 @@ class Mismatch:
     weight: np.ndarray  # (N,) each pair's weight
 
 
+class NearestPixel:
+    """Where the nearest pixel of a mask (H, W) is from any pixel: one distance transform,
+    made when first asked and then looked up (a level's foreground, against which every
+    candidate pose of the level is costed)."""
+
+    def __init__(self, mask: np.ndarray):
+        self.mask = mask
+        self._label: np.ndarray | None = None
+
+    def __call__(self, ys: np.ndarray, xs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rows and columns of the mask pixels nearest to pixels (ys, xs)."""
+        if self._label is None:
+            # OpenCV numbers the zero pixels in row-major order: label k is the k-th
+            _, self._label = cv2.distanceTransformWithLabels(
+                (~self.mask).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5,
+                labelType=cv2.DIST_LABEL_PIXEL)
+            self._flat = np.flatnonzero(self.mask)
+        return np.divmod(self._flat[self._label[ys, xs] - 1], self.mask.shape[1])
+
+
 def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLACK,
-             uncovered_weight: float = UNCOVERED_WEIGHT) -> Mismatch:
+             uncovered_weight: float = UNCOVERED_WEIGHT,
+             nearest_fg: NearestPixel | None = None) -> Mismatch:
     """Both chamfer terms between a label map (H, W; -1 where no blob) and a foreground: a
     pixel ``d`` from its match costs (min(d, cap) - slack)^2 if positive, and wants to move
     d - slack toward it (the slack forgives outline noise and the holes a body shows where
     it happens to match the backdrop). Uncovered foreground weighs ``uncovered_weight``:
-    it also comes from what the blobs do not model, and pulled the shanks toward the feet."""
+    it also comes from what the blobs do not model, and pulled the shanks toward the feet.
+    ``nearest_fg``: the foreground's ``NearestPixel``, to share between label maps."""
     covered = labels >= 0
     cost = 0.0
     # uncovered foreground pulls its nearest covered pixel; covered background is pulled to
@@ -108,13 +130,10 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
                                          (covered & ~fg, fg, False, 1.0)):
         if not src.any() or not near_mask.any():
             continue
-        # each pixel's nearest pixel of near_mask, as the rank of that pixel in row-major
-        # order (OpenCV numbers the zero pixels that way)
-        _, nearest = cv2.distanceTransformWithLabels(
-            (~near_mask).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_5,
-            labelType=cv2.DIST_LABEL_PIXEL)
+        nearest = (nearest_fg if near_mask is fg and nearest_fg is not None
+                   else NearestPixel(near_mask))
         ys, xs = np.nonzero(src)
-        iy, ix = np.divmod(np.flatnonzero(near_mask)[nearest[ys, xs] - 1], near_mask.shape[1])
+        iy, ix = nearest(ys, xs)
         dist = np.hypot(iy - ys, ix - xs)
         cost += w * float(np.sum(np.maximum(np.minimum(dist, cap) - slack, 0) ** 2))
         keep = (dist <= cap) & (dist > slack)

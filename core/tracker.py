@@ -199,7 +199,8 @@ class Tracker:
     def _foregrounds(self, frame: int, lv: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
         """Per view, the foreground of ``frame`` on level ``lv`` around the body at ``est``
-        (None when the term is off): (boolean crop, its top-left level pixel)."""
+        (None when the term is off): (boolean crop, its top-left level pixel, its
+        ``NearestPixel``)."""
         s = self.settings
         if s.silhouette <= 0:
             return None
@@ -219,7 +220,8 @@ class Tracker:
             x1 = int(min(np.ceil((boxes[:, 2].max() + margin) / g), -(-shape[1] // g)))
             y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
             fg = sil.at_level(self._foreground(c, frame), lv)[::g, ::g]
-            out.append((fg[y0:max(y1, y0), x0:max(x1, x0)], (x0, y0)))
+            crop = fg[y0:max(y1, y0), x0:max(x1, x0)]
+            out.append((crop, (x0, y0), sil.NearestPixel(crop)))
         return out
 
     def _learn_first_backdrops(self, key: BodyPose, key_frame: int) -> None:
@@ -352,9 +354,9 @@ class Tracker:
                 if view_fg is None:
                     shape_parts.append(((), (), (), ()))
                     continue
-                fg, (x0, y0) = view_fg
+                fg, (x0, y0), nearest_fg = view_fg
                 crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
-                mm = sil.mismatch(lab[crop], fg, cap)
+                mm = sil.mismatch(lab[crop], fg, cap, nearest_fg=nearest_fg)
                 shape_cost += s.silhouette * mm.cost
                 mm.model += (x0, y0)
                 mm.target += (x0, y0)

@@ -6,7 +6,7 @@ import numpy as np
 
 from core import se3
 from core.pose import INDEPENDENT, BodyPose, apply_update
-from core.silhouette import Backdrop, at_level, mismatch
+from core.silhouette import Backdrop, NearestPixel, at_level, mismatch
 from core.skeleton import planar_chain_template
 from core.tracker import Tracker, TrackerSettings, track
 from support.synthetic import render, side_view
@@ -41,6 +41,24 @@ def test_mismatch_pairs_every_pixel_with_its_nearest_match():
     d = np.hypot(*(got.target - got.model).T)
     assert np.all(d > 0) and np.all(d <= cap)
     assert covered[t[:, 1], t[:, 0]].sum() < len(t)  # some pull the model out to uncovered
+
+
+def test_one_foreground_lookup_serves_every_label_map():
+    shape = (70, 90)
+    fg = _disc(shape, (36, 35), 12) | _disc(shape, (62, 44), 7)
+    nearest = NearestPixel(fg)
+    for centre in ((30, 35), (60, 40), (20, 20)):  # candidate poses of one level
+        labels = np.where(_disc(shape, centre, 10), 0, -1)
+        alone, shared = mismatch(labels, fg, 15.0), mismatch(labels, fg, 15.0, nearest_fg=nearest)
+        assert shared.cost == alone.cost
+        np.testing.assert_array_equal(shared.model, alone.model)
+        np.testing.assert_array_equal(shared.target, alone.target)
+    ys, xs = np.nonzero(~fg)
+    iy, ix = nearest(ys, xs)
+    assert fg[iy, ix].all()  # every pixel's match is foreground, and no nearer one is
+    fy, fx = np.nonzero(fg)
+    for y, x, my, mx in list(zip(ys, xs, iy, ix))[::97]:
+        assert np.hypot(my - y, mx - x) <= np.hypot(fy - y, fx - x).min() + 0.5
 
 
 def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
