@@ -99,7 +99,8 @@ class NearestPixel:
 
     def __init__(self, mask: np.ndarray):
         self.mask = mask
-        self._label: np.ndarray | None = None
+        self._label: np.ndarray | None = None  # per pixel, the rank of its nearest
+        self._flat: np.ndarray | None = None  # flat index of each mask pixel, by rank
 
     def __call__(self, ys: np.ndarray, xs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Rows and columns of the mask pixels nearest to pixels (ys, xs)."""

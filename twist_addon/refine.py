@@ -14,7 +14,7 @@ import numpy as np
 from mathutils import Vector
 
 from ..core.pose import CALIBRATED
-from ..core.refine import RefineError, refine
+from ..core.refine import SETTLED_SHIFT, SETTLED_TURN, RefineError, refine
 from ..core.skeleton import BALL, HINGE, Skeleton
 from . import keyframes
 from .bridge import BridgeError, set_pose, skeleton_from_armature
@@ -108,7 +108,8 @@ class TWIST_OT_refine_skeleton(ArmatureAction, bpy.types.Operator):
     rounds: bpy.props.IntProperty(
         name="Rounds", default=10, min=1, max=30,
         description="Track-and-refine rounds, at most: each tracks the whole range, and "
-                    "refining stops once the joints settle (under 1 mm and 0.5 degrees)")
+                    "refining stops once a round moves no joint "
+                    f"{1000 * SETTLED_SHIFT:g} mm and turns no axis {SETTLED_TURN:g} degrees")
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self)
