@@ -53,13 +53,17 @@ def write_rest_pose(arm, old: Skeleton, new: Skeleton) -> list[str]:
     return [old.names[j] for j in changed]
 
 
-def refine_armature(scene, only_selected: bool, planar: bool, rounds: int) -> dict[str, float]:
+def refine_armature(scene, only_selected: bool, planar: bool, rounds: int,
+                    progress=None) -> tuple[dict[str, float], str]:
     """Refine the scene armature's tracked joints (the selected bones only, if asked) over
     the frames from the current one to the end (or start, tracking backward), one round at a
-    time, writing each round into the rest pose so that the bones' blobs follow their heads;
-    returns each refined bone's move in world units, over all rounds."""
-    start, moves = None, {}
-    for _ in range(rounds):
+    time, writing each round into the rest pose so that the bones' blobs follow their heads,
+    until the joints settle or ``rounds`` are done; ``progress(rounds_done)`` after each.
+    Returns each refined bone's move in world units over all rounds, and why the rounds
+    stopped early ('' if they did not): a round that cannot refine (its tracking diverged)
+    keeps the rounds before it; only a first round's error is raised, with nothing changed."""
+    start, moves, stopped = None, {}, ""
+    for r in range(rounds):
         session = TrackSession.from_scene(scene)
         tracker = session.tracker
         if tracker.mode != CALIBRATED:
@@ -77,17 +81,22 @@ def refine_armature(scene, only_selected: bool, planar: bool, rounds: int) -> di
             result = refine(sk, tracker.seq.images, session.initial, names, tracker.settings,
                             planar, rounds=1)
         except RefineError as e:
-            raise BridgeError(str(e)) from None
+            if r == 0:
+                raise BridgeError(str(e)) from None
+            stopped = f"round {r + 1} could not refine ({e}); the skeleton of round {r} is kept"
+            break
         moved = write_rest_pose(arm, sk, result.skeleton)
         new_sk = skeleton_from_armature(arm)
         set_pose(arm, new_sk, result.initial.rotations, result.initial.root_position)
         for n in moved:
             j = sk.index(n)
             moves[n] = float(np.linalg.norm(new_sk.rest_positions[j] - start[j]))
+        if progress:
+            progress(r + 1)
         if result.settled():
             break
-    keyframes.clear(arm, new_sk, set(session.frames[1:]))
-    return moves
+    keyframes.clear(arm, skeleton_from_armature(arm), set(session.frames[1:]))
+    return moves, stopped
 
 
 class TWIST_OT_refine_skeleton(ArmatureAction, bpy.types.Operator):
@@ -115,11 +124,22 @@ class TWIST_OT_refine_skeleton(ArmatureAction, bpy.types.Operator):
         return context.window_manager.invoke_props_dialog(self)
 
     def run(self, context) -> str:
-        moved = refine_armature(context.scene, self.only_selected, self.planar, self.rounds)
-        if bpy.ops.twist.track() != {"FINISHED"}:
-            raise BridgeError("the refined skeleton could not be tracked again")
+        wm = context.window_manager
+        wm.progress_begin(0, self.rounds)
+        try:
+            moved, stopped = refine_armature(context.scene, self.only_selected, self.planar,
+                                             self.rounds, wm.progress_update)
+        finally:
+            wm.progress_end()
+        # the rest pose has changed: what goes wrong from here is reported, not undone
+        if stopped:
+            self.report({"WARNING"}, stopped)
+        tracked = bpy.ops.twist.track() == {"FINISHED"}
+        if not tracked:
+            self.report({"WARNING"}, "the refined skeleton could not be tracked again: "
+                        "see Results, then Track")
         shown = ", ".join(f"{n} {100 * d:.1f} cm" for n, d in moved.items()) or "nothing"
-        return f"refined and tracked again; joints moved: {shown}"
+        return f"refined{' and tracked again' if tracked else ''}; joints moved: {shown}"
 
 
 CLASSES = (TWIST_OT_refine_skeleton,)

@@ -158,3 +158,41 @@ def test_refine_skeleton_brings_a_misplaced_knee_back_and_tracks_again(bpy_modul
         b.select = False
     with pytest.raises(RuntimeError, match="no tracked bone is selected to refine"):
         bpy.ops.twist.refine_skeleton()
+
+
+def test_a_refine_round_that_fails_keeps_the_rounds_before_it(bpy_module, registered,
+                                                              long_footage, monkeypatch):
+    """A later round whose tracking diverges (staged here: the footage's own rounds settle)
+    leaves the armature as the rounds before it made it, keyed again; a first round that
+    fails changes nothing."""
+    bpy = bpy_module
+    module = sys.modules[registered.twist_addon.__name__ + ".refine"]
+    real, calls, fail_at = module.refine, [], 1
+
+    def round_fails(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == fail_at:
+            raise module.RefineError("tracking diverged at frame 9 of the range")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(module, "refine", round_fails)
+    scene, arm = _scene(bpy, registered, long_footage, 21)
+    for b in arm.pose.bones:
+        b.select = b.name in ("LeftKnee", "RightHip")
+    head = {b.name: np.array(b.head_local) for b in arm.data.bones}
+    with pytest.raises(RuntimeError, match="tracking diverged at frame 9"):
+        bpy.ops.twist.refine_skeleton(rounds=3)
+    assert all(np.array_equal(b.head_local, head[b.name]) for b in arm.data.bones)
+    assert arm.animation_data is None or arm.animation_data.action is None
+
+    calls.clear()
+    fail_at = 2
+    assert bpy.ops.twist.refine_skeleton(rounds=3) == {"FINISHED"}
+    assert len(calls) == 2  # the third round was not tried
+    moved = [n for n in ("LeftKnee", "RightHip")
+             if not np.allclose(arm.data.bones[n].head_local, head[n], atol=1e-6)]
+    assert moved  # round 1's refinement is in the rest pose
+    np.testing.assert_allclose(arm.data.bones["LeftAnkle"].head_local, head["LeftAnkle"],
+                               atol=1e-6)
+    keyed = _channel_frames(arm)
+    assert all(set(range(2, 22)) <= {f for f, _ in keyed[b]} for b in TRACKED)
