@@ -121,18 +121,19 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
     d - slack toward it (the slack forgives outline noise and the holes a body shows where
     it happens to match the backdrop). Uncovered foreground weighs ``uncovered_weight``:
     it also comes from what the blobs do not model, and pulled the shanks toward the feet.
-    ``nearest_fg``: the foreground's ``NearestPixel``, to share between label maps."""
+    ``nearest_fg``: the foreground's ``NearestPixel`` (its mask is ``fg``), to share
+    between label maps."""
     covered = labels >= 0
     cost = 0.0
     # uncovered foreground pulls its nearest covered pixel; covered background is pulled to
     # its nearest foreground pixel
     model, target, weight = [], [], []
-    for src, near_mask, move_near, w in ((fg & ~covered, covered, True, uncovered_weight),
-                                         (covered & ~fg, fg, False, 1.0)):
-        if not src.any() or not near_mask.any():
+    nearest_fg = NearestPixel(fg) if nearest_fg is None else nearest_fg
+    for src, nearest, move_near, w in ((fg & ~covered, NearestPixel(covered), True,
+                                        uncovered_weight),
+                                       (covered & ~fg, nearest_fg, False, 1.0)):
+        if not src.any() or not nearest.mask.any():
             continue
-        nearest = (nearest_fg if near_mask is fg and nearest_fg is not None
-                   else NearestPixel(near_mask))
         ys, xs = np.nonzero(src)
         iy, ix = nearest(ys, xs)
         dist = np.hypot(iy - ys, ix - xs)
