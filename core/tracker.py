@@ -184,12 +184,11 @@ class Tracker:
         self._dof_joint = skeleton.dof_joints_and_axes()[0]
         self.n_dof = len(self._dof_joint)
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
+        self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are now, stacked
         # thinnest blob each degree of freedom turns directly, world units (inf: none)
         thin = np.full(skeleton.n_joints, np.inf)
-        for b in skeleton.blobs:
-            thin[b.joint] = min(thin[b.joint], float(np.min(b.radii[1:])))
+        np.minimum.at(thin, self._blobs.joint, self._blobs.radii[:, 1:].min(axis=1))
         self.dof_thickness = thin[self._dof_joint]
-        self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are now, stacked
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
         self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
