@@ -95,7 +95,7 @@ def refine_armature(scene, only_selected: bool, planar: bool, rounds: int,
             progress(r + 1)
         if result.settled():
             break
-    keyframes.clear(arm, skeleton_from_armature(arm), set(session.frames[1:]))
+    keyframes.clear(arm, new_sk, set(session.frames[1:]))  # the last round kept
     return moves, stopped
 
 
