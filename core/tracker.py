@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import image as imagelib
-from . import raycast
+from . import raycast, se3
 from . import silhouette as sil
 from .blas import one_blas_thread
 from .linearize import Kinematics, rows
@@ -181,7 +181,7 @@ class Tracker:
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
-        self._dof_joint = skeleton.dof_joints_and_axes()[0]
+        self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
         self.n_dof = len(self._dof_joint)
         self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
         self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are now, stacked
@@ -573,6 +573,21 @@ class Tracker:
         return result
 
     # --- the sequence ----------------------------------------------------------------------
+    def _predicted(self, before: BodyPose, last: BodyPose) -> BodyPose:
+        """Constant-velocity prediction from the poses of the two frames before, except that a
+        limited hinge whose turn would carry it past its limits is predicted where it was:
+        carried on, an elbow the limb search had just turned 75 degrees wrapped round past 180
+        and came out bent backward; stopped at the limit, it was 30 degrees off."""
+        pred = extrapolate(before, last, self.settings.prediction_gain)
+        for k in self._limited:
+            j, axis = self._dof_joint[k], self._dof_axis[k]
+            step = se3.log_so3(before.rotations[j].T @ last.rotations[j]) @ axis
+            lo, hi = self.skeleton.hinge_turns(j, last.rotations[j])
+            turn = self.settings.prediction_gain * step
+            turn = turn if lo <= turn <= hi else 0.0
+            pred.rotations[j] = last.rotations[j] @ se3.exp_so3(axis * turn)
+        return pred
+
     def iter_track(self, initial: BodyPose, frames: Sequence[int],
                    corrections: Mapping[int, BodyPose] | None = None) -> Iterator[FrameResult]:
         """Track through ``frames`` (indices into every view's images, in tracking order,
@@ -609,10 +624,8 @@ class Tracker:
                 yield res
                 history = history[-1:] + [res]
                 continue
-            if len(history) >= 2:
-                pred = extrapolate(history[-2].pose, prev.pose, self.settings.prediction_gain)
-            else:
-                pred = prev.pose.copy()
+            pred = (self._predicted(history[-2].pose, prev.pose) if len(history) >= 2
+                    else prev.pose.copy())
             try:
                 with one_blas_thread():
                     res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)

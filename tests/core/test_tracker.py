@@ -92,6 +92,31 @@ def test_constant_velocity_prediction_continues_a_steady_motion(body):
         np.testing.assert_allclose(M2, M1 @ np.linalg.inv(M0) @ M1, atol=1e-9)
 
 
+def test_the_prediction_holds_a_hinge_that_its_speed_would_carry_past_a_limit(body):
+    """Knees limited to 0-150 degrees: one bending 40 degrees a frame from 100 to 140 is
+    predicted at 140 (carried on, it would pass the limit, and past 180 wrap round to bend
+    backward); one bending 20 from 60 carries on to 100, and a ball joint carries on too."""
+    _, pose = body
+    sk = human_template()  # a skeleton of its own: the test sets limits on it
+    fast, slow, hip = sk.index("LeftKnee"), sk.index("RightKnee"), sk.index("LeftHip")
+    sk.limits[fast] = sk.limits[slow] = np.radians([0, 150])
+    frames = [[render(sk, pose, c)] for c in range(3)]
+    tracker = Tracker(sk, frames, CALIBRATED)
+
+    def posed(fast_deg, slow_deg, hip_turn):
+        p = pose.copy()
+        p.rotations[fast] = se3.exp_so3(sk.axes[fast] * np.radians(fast_deg))
+        p.rotations[slow] = se3.exp_so3(sk.axes[slow] * np.radians(slow_deg))
+        p.rotations[hip] = se3.exp_so3(np.array([0.1, 0.2, -0.1]) * hip_turn)
+        return p
+
+    pred = tracker._predicted(posed(100, 60, 1.0), posed(140, 80, 2.0))
+    assert np.degrees(sk.hinge_angle(fast, pred.rotations[fast])) == pytest.approx(140)
+    assert np.degrees(sk.hinge_angle(slow, pred.rotations[slow])) == pytest.approx(100)
+    np.testing.assert_allclose(pred.rotations[hip], posed(0, 0, 3.0).rotations[hip],
+                               atol=1e-12)
+
+
 def test_cancel_keeps_the_frames_already_tracked(body):
     sk, pose = body
     frames = [[render(sk, pose, c)] * 6 for c in range(3)]
