@@ -76,7 +76,7 @@ class TrackerSettings:
                                    "(0: start from the last pose)")
     converge_pixels: float = _knob(0.2, "Stop iterating a level when no blob moves more "
                                    "pixels than this")
-    min_blob_pixels: float = _knob(1.0, "Solve a joint on levels where its blob is at least "
+    min_blob_pixels: float = _knob(1.5, "Solve a joint on levels where its blob is at least "
                                    "this many pixels thick")
     divergence_ratio: float = _knob(3.0, "Flag a frame whose residual exceeds the median so "
                                     "far by this factor")
@@ -524,9 +524,7 @@ class Tracker:
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)
             active = self._active(est, lv)
-            # a silhouette where some limb cannot move yet would pull the rest in its place
-            fgs = (self._foregrounds(frame, lv, key, key_frame, est, kin) if active.all()
-                   else None)
+            fgs = self._foregrounds(frame, lv, key, key_frame, est, kin)
             smp = self._sample(est, kin, sets, levels, lv, None, fgs)
             sigmas = smp.sigmas
             left = self._left_views(smp)
