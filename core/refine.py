@@ -137,6 +137,27 @@ def centre_from_twists(W: np.ndarray, rcond: float = 0.1) -> np.ndarray:
     return np.linalg.lstsq(A, np.concatenate(list(W[:3].T)), rcond=rcond)[0]
 
 
+def joint_from_track(tracker: Tracker, poses: Sequence[BodyPose], frames: Sequence[int],
+                     joint: int, planar: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+    """What the footage says of ``joint`` at the tracked ``poses`` of ``frames``: its centre's
+    shift (3,) and, for a hinge, its axis (3,; None for a ball, whose centre alone is
+    learned), both in the joint's rest frame, as ``moved_joint`` takes them."""
+    sk = tracker.skeleton
+    with one_blas_thread():  # the same sums in the same order on any machine
+        W = segment_twists(tracker, poses, frames, joint, planar)
+    if sk.kinds[joint] != HINGE:
+        return centre_from_twists(W), None
+    # a hinge turns about R_j a in the frame before its rotation (R_j = R_j(0) exp(theta
+    # a)), so the axis found there is taken back through R_j(0)
+    R0 = poses[0].rotations[joint]
+    axis, point = hinge_from_twists(without_spin(W, poses, sk, joint), R0 @ sk.axes[joint])
+    axis = R0.T @ axis
+    if planar:  # the axis stays along the view; the centre moves across it
+        axis = sk.axes[joint]
+        point = point - (R0 @ axis) * (point @ (R0 @ axis))
+    return point, axis
+
+
 def moved_joint(sk: Skeleton, joint: int, shift: np.ndarray, axis: np.ndarray | None = None
                 ) -> Skeleton:
     """The skeleton with ``joint``'s centre moved by ``shift`` (its local frame, which is the
@@ -246,21 +267,10 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
         poses = [f.pose for f in result.frames]
         shifts, turns, new = {}, {}, sk
         for j in idx:
-            with one_blas_thread():  # the same sums in the same order on any machine
-                W = segment_twists(tracker, poses, frames, j, planar)
-            if sk.kinds[j] == HINGE:
-                # a hinge turns about R_j a in the frame before its rotation (R_j = R_j(0)
-                # exp(theta a)), so the axis found there is taken back through R_j(0)
-                R0 = poses[0].rotations[j]
-                axis, point = hinge_from_twists(without_spin(W, poses, sk, j), R0 @ sk.axes[j])
-                axis = R0.T @ axis
-                if planar:  # the axis stays along the view; the centre moves across it
-                    axis = sk.axes[j]
-                    point = point - (R0 @ axis) * (point @ (R0 @ axis))
+            point, axis = joint_from_track(tracker, poses, frames, j, planar)
+            if axis is not None:
                 turns[sk.names[j]] = float(np.degrees(se3.angle_between_vectors(axis,
                                                                              sk.axes[j])))
-            else:
-                axis, point = None, centre_from_twists(W)
             new = moved_joint(new, j, point, axis)
             shifts[sk.names[j]] = float(np.linalg.norm(point))
         pose = carried_pose(sk, new, pose)
