@@ -3,12 +3,16 @@ with a skeleton whose left knee sits 4 cm forward of the capture's and whose rig
 is turned 15 degrees, refined (core.refine), and scored before and after.
 
     python bench/refine_benchmark.py [--cache .cache/walk] [--first 60] [--last 119]
-                                     [--rounds 10]
+                                     [--rounds 10] [--zoom 1]
 
 Frames are indices into the 30 fps footage (the default stretch is its steady walking, to
 the end); the refinement runs until the joints settle or ``--rounds`` are done. Prints each
 refined joint's centre and axis error against the capture's skeleton and the legs'
-limb-direction errors when tracked with the skeleton before and after refinement.
+limb-direction errors when tracked with the skeleton before and after refinement, and,
+as the floor those errors read against, what the same estimate makes of each joint at the
+capture's own poses instead of tracked ones (no tracking error to carry). With
+``--zoom 2`` the footage is 960x720 of the same stage (cached in .cache/walk2x), to tell
+what the footage's resolution decides from what it does not.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
 from core.pose import BodyPose  # noqa: E402
-from core.refine import carried_pose, moved_joint, refine  # noqa: E402
+from core.refine import carried_pose, joint_from_track, moved_joint, refine  # noqa: E402
 from core.tracker import Tracker, track  # noqa: E402
 
 LEGS = ["left thigh", "right thigh", "left shank", "right shank"]
@@ -57,15 +61,25 @@ def leg_errors(sk, truth_sk, images, initial, truth, frames) -> dict[str, float]
             for k in LEGS}
 
 
+def at_capture(sk, images, truth, cameras, joint: int) -> tuple[np.ndarray, np.ndarray]:
+    """``core.refine``'s reading of ``joint`` (centre shift, hinge axis) from the footage at
+    the capture's own poses ``truth`` (rotations, roots) of every frame of ``images``."""
+    poses = [BodyPose(R.copy(), p.copy(), [c.copy() for c in cameras]) for R, p in zip(*truth)]
+    return joint_from_track(Tracker(sk, images, "calibrated"), poses, range(len(poses)), joint)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
+    ap.add_argument("--cache", type=Path, help="footage folder (default: .cache/walk, or "
+                    ".cache/walk<zoom>x)")
     ap.add_argument("--first", type=int, default=60)
     ap.add_argument("--last", type=int, help="one past the last frame (default: the end)")
     ap.add_argument("--rounds", type=int, default=10, help="track-and-refine rounds, at most")
+    ap.add_argument("--zoom", type=int, default=1, help="footage this many times 480x360")
     a = ap.parse_args(argv)
+    a.cache = a.cache or ROOT / ".cache" / ("walk" if a.zoom == 1 else f"walk{a.zoom}x")
     t0 = time.perf_counter()
-    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
+    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"], a.zoom)
     a.last = len(info["frames"]) if a.last is None else a.last
     if not 0 <= a.first < a.last - 2 or a.last > len(info["frames"]):
         ap.error(f"--first {a.first} --last {a.last}: the footage has frames 0-"
@@ -93,8 +107,8 @@ def main(argv=None) -> int:
     print(f"frames {a.first}-{a.last - 1} of the 30 fps footage, {len(result.shifts)} rounds"
           f" ({settled})\n")
     print("| joint | centre error before | after | axis error before | after | after, against"
-          " the capture's own axis |")
-    print("|---|---|---|---|---|---|")
+          " the capture's own axis | read at the capture's poses |")
+    print("|---|---|---|---|---|---|---|")
     for j in (lk, rk):
         def centre(s, j=j):
             return 100 * np.linalg.norm(s.rest_positions[j] - truth_sk.rest_positions[j])
@@ -104,9 +118,12 @@ def main(argv=None) -> int:
             return min(a, 180 - a)  # a hinge axis has no sign
 
         own = capture_axis(truth[0][:, j])
+        shift, floor_axis = at_capture(truth_sk, images, truth, job.cameras, j)
+        floor = moved_joint(truth_sk, j, shift, floor_axis)
         print(f"| {truth_sk.names[j]} | {centre(guess):.1f} cm | {centre(refined):.1f} cm |"
               f" {axis(guess):.1f}° | {axis(refined):.1f}° | {axis(refined, want=own):.1f}°"
-              f" (job's axis: {axis(truth_sk, want=own):.1f}°) |")
+              f" (job's axis: {axis(truth_sk, want=own):.1f}°) | {centre(floor):.1f} cm,"
+              f" {axis(floor):.1f}° |")
     before = leg_errors(guess, truth_sk, images, initial, truth, frames)
     after = leg_errors(refined, truth_sk, images, result.initial, truth, frames)
     exact = leg_errors(truth_sk, truth_sk, images, initial_true, truth, frames)

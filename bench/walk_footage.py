@@ -86,12 +86,14 @@ DEFAULT_RADIUS = (0.03, 0.03)
 SKIPPED = ("Fingers", "Thumb", "hand")  # small parts left out of the body
 
 
-def backdrop() -> np.ndarray:
+def backdrop(zoom: int = 1) -> np.ndarray:
     """Muybridge's stage: a dark backdrop ruled with light lines every GRID_PIXELS, BGR 0..255
-    (HEIGHT, WIDTH, 3). Static in every view: the tracker must ignore it inside its blobs."""
-    img = np.full((HEIGHT, WIDTH, 3), 22.0)
-    img[GRID_PIXELS // 2 :: GRID_PIXELS, :] = 120.0
-    img[:, GRID_PIXELS // 2 :: GRID_PIXELS] = 120.0
+    (HEIGHT, WIDTH, 3), each ``zoom`` times larger. Static in every view: the tracker must
+    ignore it inside its blobs."""
+    img = np.full((HEIGHT * zoom, WIDTH * zoom, 3), 22.0)
+    grid = GRID_PIXELS * zoom
+    img[grid // 2 :: grid, :] = 120.0
+    img[:, grid // 2 :: grid] = 120.0
     return img
 
 
@@ -113,14 +115,15 @@ def camera_rotations() -> dict[str, np.ndarray]:
     }
 
 
-def job_camera(R: np.ndarray) -> dict:
-    """The job's camera dict: pixel = s (R X + t)[:2] + center, with STAGE_CENTRE mid-image."""
+def job_camera(R: np.ndarray, zoom: int = 1) -> dict:
+    """The job's camera dict: pixel = s (R X + t)[:2] + center, with STAGE_CENTRE mid-image
+    (footage ``zoom`` times the size: the same stage in more pixels)."""
     return {
         "model": "scaled_orthographic",
         "R": R.tolist(),
         "t": (-R @ STAGE_CENTRE).tolist(),
-        "scale": PIXELS_PER_METRE,
-        "center": [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5],
+        "scale": PIXELS_PER_METRE * zoom,
+        "center": [WIDTH * zoom / 2 - 0.5, HEIGHT * zoom / 2 - 0.5],
     }
 
 
@@ -188,7 +191,7 @@ def _capsule_body(sk, spacing: float = 0.01, around: int = 32):
     return np.array(verts), np.array(faces), groups
 
 
-def build_scene(bpy, bvh_path: Path):
+def build_scene(bpy, bvh_path: Path, zoom: int = 1):
     """Import the capture, build the skinned body, set up Workbench; returns the armature."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_anim.bvh(filepath=str(bvh_path), axis_forward="Y", axis_up="Z",
@@ -229,7 +232,7 @@ def build_scene(bpy, bvh_path: Path):
     scene.display.shading.color_type = "VERTEX"
     scene.display.shading.show_shadows = False
     scene.display.shading.show_cavity = False
-    scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
+    scene.render.resolution_x, scene.render.resolution_y = WIDTH * zoom, HEIGHT * zoom
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
     scene.render.image_settings.color_mode = "RGBA"
@@ -260,13 +263,18 @@ def add_camera(bpy, name: str, R: np.ndarray):
     return cam
 
 
-def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dict:
+def render(out: Path, first: int, last: int, step: int, views: list[str], zoom: int = 1
+           ) -> dict:
+    """Render the capture's frames first..last (every ``step``-th) in each view into OUT
+    (``zoom`` times WIDTH x HEIGHT, the same stage), keeping frames already rendered with
+    the same settings; returns the frames, the job cameras and how many were rendered."""
     import bpy
     import cv2
 
     out.mkdir(parents=True, exist_ok=True)
     frames = list(range(first, last + 1, step))
-    meta = {"bvh": str(CMU_WALK), "frames": frames, "width": WIDTH, "height": HEIGHT,
+    meta = {"bvh": str(CMU_WALK), "frames": frames, "width": WIDTH * zoom,
+            "height": HEIGHT * zoom,
             "noise": NOISE_SIGMA, "version": 2}
     stamp = out / "footage.json"
     rots = camera_rotations()
@@ -277,7 +285,7 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
             k: meta[k] for k in ("width", "height", "noise", "version")}:
         todo = [(v, f) for v in views for f in frames]
     if todo:
-        arm, _ = build_scene(bpy, CMU_WALK)
+        arm, _ = build_scene(bpy, CMU_WALK, zoom)
         scene = bpy.context.scene
         cams = {v: add_camera(bpy, v, rots[v]) for v in views}
         rng = np.random.default_rng(first * 7919 + last)
@@ -290,7 +298,7 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
             bpy.ops.render.render(write_still=True)
             rgba = cv2.imread(str(path), cv2.IMREAD_UNCHANGED).astype(np.float32)
             alpha = rgba[..., 3:] / 255
-            img = rgba[..., :3] * alpha + backdrop() * (1 - alpha)
+            img = rgba[..., :3] * alpha + backdrop(zoom) * (1 - alpha)
             img += rng.normal(0, NOISE_SIGMA, img.shape)
             cv2.imwrite(str(path), np.clip(img + 0.5, 0, 255).astype(np.uint8))
     stamp.write_text(json.dumps(meta, indent=1))
@@ -298,7 +306,7 @@ def render(out: Path, first: int, last: int, step: int, views: list[str]) -> dic
     truth.motion = truth.motion[frames]
     truth.frame_time *= step
     write_bvh(truth, out / "truth.bvh")
-    cams_json = {v: job_camera(rots[v]) for v in views}
+    cams_json = {v: job_camera(rots[v], zoom) for v in views}
     (out / "cameras.json").write_text(json.dumps(cams_json, indent=1))
     return {"frames": frames, "cameras": cams_json, "rendered": len(todo)}
 
@@ -365,8 +373,9 @@ def main(argv=None) -> int:
     ap.add_argument("--last", type=int, default=772)
     ap.add_argument("--step", type=int, default=4, help="capture frames per rendered frame")
     ap.add_argument("--views", default="lateral,endon,oblique60")
+    ap.add_argument("--zoom", type=int, default=1, help="footage this many times 480x360")
     a = ap.parse_args(argv)
-    info = render(a.out, a.first, a.last, a.step, a.views.split(","))
+    info = render(a.out, a.first, a.last, a.step, a.views.split(","), a.zoom)
     print(f"{len(info['frames'])} frames x {len(info['cameras'])} views in {a.out}"
           f" ({info['rendered']} rendered now)")
     return 0
