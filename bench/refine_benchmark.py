@@ -3,7 +3,7 @@ with a skeleton whose left knee sits 4 cm forward of the capture's and whose rig
 is turned 15 degrees, refined (core.refine), and scored before and after.
 
     python bench/refine_benchmark.py [--cache .cache/walk] [--first 60] [--last 119]
-                                     [--rounds 10] [--zoom 1]
+                                     [--rounds 10] [--zoom 1] [--spine]
 
 Frames are indices into the 30 fps footage (the default stretch is its steady walking, to
 the end); the refinement runs until the joints settle or ``--rounds`` are done. Prints each
@@ -30,7 +30,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
-from walk_footage import render, write_job  # noqa: E402
+from walk_footage import JOINTS, SPINE_JOINTS, render, write_job  # noqa: E402
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
@@ -76,6 +76,8 @@ def main(argv=None) -> int:
     ap.add_argument("--last", type=int, help="one past the last frame (default: the end)")
     ap.add_argument("--rounds", type=int, default=10, help="track-and-refine rounds, at most")
     ap.add_argument("--zoom", type=int, default=1, help="footage this many times 480x360")
+    ap.add_argument("--spine", action="store_true", help="track the lower back too (22 "
+                    "degrees of freedom instead of the paper's 19)")
     a = ap.parse_args(argv)
     a.cache = a.cache or ROOT / ".cache" / ("walk" if a.zoom == 1 else f"walk{a.zoom}x")
     t0 = time.perf_counter()
@@ -84,9 +86,9 @@ def main(argv=None) -> int:
     if not 0 <= a.first < a.last - 2 or a.last > len(info["frames"]):
         ap.error(f"--first {a.first} --last {a.last}: the footage has frames 0-"
                  f"{len(info['frames']) - 1}; give at least three, with --last one past them")
-    views, mode, _ = RUNS["3 views calibrated 30 fps"]
+    views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
     job = load_job(write_job(a.cache, "refine", views, mode, info["frames"], info["cameras"],
-                             {}, 4 / 120))
+                             {}, 4 / 120, SPINE_JOINTS if a.spine else JOINTS))
     truth_sk = job.skeleton
     T = read_bvh(a.cache / "truth.bvh").poses()
     sel = slice(a.first, a.last)

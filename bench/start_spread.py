@@ -4,7 +4,7 @@ scored against the capture, with their mean; or, with --windows K, many short ru
 show how fast a limb is lost from the true pose, with far less spread than whole runs.
 
     python bench/start_spread.py [--cache .cache/walk] [--quick | --windows K]
-                                 [--settings JSON]
+                                 [--settings JSON] [--spine]
 
 A run starting on frame k of the 30 fps footage is posed there with the capture's pose; a
 15 fps run takes every other frame from there. Sixteen runs (15 fps forward from frames 0-5
@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
-from walk_footage import CAPTURE_FPS, render, write_job  # noqa: E402
+from walk_footage import CAPTURE_FPS, JOINTS, SPINE_JOINTS, render, write_job  # noqa: E402
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
@@ -101,12 +101,15 @@ def main(argv=None) -> int:
     ap.add_argument("--windows", type=int, default=0, metavar="K",
                     help="short runs of K tracked frames from the true pose instead")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
+    ap.add_argument("--spine", action="store_true", help="track the lower back too (22 "
+                    "degrees of freedom instead of the paper's 19)")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
-    views, mode, _ = RUNS["3 views calibrated 30 fps"]
+    views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
     job_path = write_job(a.cache, "start_spread", views, mode, info["frames"], info["cameras"],
-                         json.loads(a.settings), 4 / CAPTURE_FPS)
+                         json.loads(a.settings), 4 / CAPTURE_FPS,
+                         SPINE_JOINTS if a.spine else JOINTS)
     runs = windows(a.windows) if a.windows else starts(a.quick)
     given = 2 if a.windows else 1
     with Pool(2) as pool:

@@ -51,6 +51,11 @@ JOINTS = {
     "LeftElbow": {"kind": "hinge", "axis": [0.87, 0.0, -0.5], "limits": [-160, 0]},
     "RightElbow": {"kind": "hinge", "axis": [0.87, 0.0, 0.5], "limits": [-160, 0]},
 }
+# The same body with the lower back a ball too (22 degrees of freedom): as it walks, the
+# capture's pelvis turns and tilts against its chest, and a trunk rigid from the hips to the
+# neck can only split the difference (on steady walking its pelvis was tracked 11 degrees
+# off in yaw and 5 in roll, and the hips' centres, which the thighs hang from, with it)
+SPINE_JOINTS = {**JOINTS, "lowerback": "ball"}
 # blob short radii a user would set to line the blobs up with this body (metres)
 BLOBS = {
     "LHipJoint": {"radius": 0.1}, "RHipJoint": {"radius": 0.1},
@@ -346,14 +351,15 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
 
 
 def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list[int],
-              cameras: dict, settings: dict, frame_time: float) -> Path:
+              cameras: dict, settings: dict, frame_time: float, joints: dict = JOINTS
+              ) -> Path:
     """Write folder/jobs/<name>.json tracking the given rendered frames (capture indices) of
-    the given views; the skeleton and initial pose come from folder/truth.bvh's first frame,
-    which must be the first of ``frames``."""
+    the given views with the tracked ``joints``; the skeleton and initial pose come from
+    folder/truth.bvh's first frame, which must be the first of ``frames``."""
     jobs = folder / "jobs"
     jobs.mkdir(exist_ok=True)
     job = {
-        "skeleton": {"bvh": "../truth.bvh", "joints": JOINTS, "blobs": BLOBS},
+        "skeleton": {"bvh": "../truth.bvh", "joints": joints, "blobs": BLOBS},
         "initial": {"bvh": "../truth.bvh", "frame": 0},
         "views": [{"images": [f"../{v}/{f:04d}.png" for f in frames], "camera": cameras[v]}
                   for v in views],
