@@ -316,9 +316,10 @@ def render(out: Path, first: int, last: int, step: int, views: list[str], zoom: 
     return {"frames": frames, "cameras": cams_json, "rendered": len(todo)}
 
 
-def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images: str = "*.png"):
+def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images: str = "*.png",
+                   joints: dict = JOINTS):
     """Make the current scene ready to track rendered walk footage in ``folder``: the capture
-    (folder/truth.bvh) imported as an armature and posed on frame 1, the tracked bones
+    (folder/truth.bvh) imported as an armature and posed on frame 1, the bones of ``joints``
     unlocked (as balls: Blender's bone axes are not the capture's hinge axes), envelope radii
     from BLOBS, one orthographic camera and view per rendered view, frames 1..last_frame.
     Needs the add-on registered; resetting the scene is the caller's (a factory reset disables
@@ -330,7 +331,7 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
     scene.frame_set(1)
     arm.animation_data_clear()  # the pose of frame 1 stays: the user's initial pose
     for pb in arm.pose.bones:
-        pb.lock_rotation = (pb.name not in JOINTS,) * 3
+        pb.lock_rotation = (pb.name not in joints,) * 3
     bpy.context.view_layer.objects.active = arm
     bpy.ops.object.mode_set(mode="EDIT")
     for eb in arm.data.edit_bones:

@@ -3,8 +3,9 @@ environment): ``python example_blends/build_examples.py``.
 
 walk_3view.blend: three orthographic views of the CMU walk, rendered by bench/walk_footage.py
 (one second of steady walking at 15 frames per second, JPEG frames in walk_3view/), the
-capture's armature posed on frame 1, ready for Track. The capture's frames that were rendered
-are kept as walk_3view/truth.bvh.
+capture's armature posed on frame 1 with its lower back free as well as the paper's 19
+degrees of freedom (bench/walk_footage.py's SPINE_JOINTS), ready for Track. The capture's
+frames that were rendered are kept as walk_3view/truth.bvh.
 
 muybridge_horse.blend: Muybridge's "Sallie Gardner at a Gallop" plates behind one orthographic
 camera, and the planar quadruped template placed and scaled over the horse on plate 1;
@@ -31,7 +32,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from addon_dev import load_addon  # noqa: E402
-from walk_footage import render, tracking_scene  # noqa: E402
+from walk_footage import SPINE_JOINTS, render, tracking_scene  # noqa: E402
 
 WALK = dict(first=540, last=660, step=8)  # capture frames: one second at 15 fps
 VIEWS = ["lateral", "endon", "oblique60"]
@@ -53,7 +54,7 @@ def build_walk(bpy) -> Path:
     bpy.ops.wm.read_factory_settings(use_empty=True)
     path = HERE / "walk_3view.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))  # so that // paths mean this folder
-    scene, arm = tracking_scene(bpy, out, VIEWS, len(info["frames"]), "*.jpg")
+    scene, arm = tracking_scene(bpy, out, VIEWS, len(info["frames"]), "*.jpg", SPINE_JOINTS)
     for view in scene.twist.views:
         view.images = bpy.path.relpath(view.images)
     scene.render.fps = 15
