@@ -37,6 +37,7 @@ from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
 from core.pose import BodyPose  # noqa: E402
 from core.refine import carried_pose, joint_from_track, moved_joint, refine  # noqa: E402
+from core.skeleton import Skeleton  # noqa: E402
 from core.tracker import Tracker, track  # noqa: E402
 
 LEGS = ["left thigh", "right thigh", "left shank", "right shank"]
@@ -61,11 +62,14 @@ def leg_errors(sk, truth_sk, images, initial, truth, frames) -> dict[str, float]
             for k in LEGS}
 
 
-def at_capture(sk, images, truth, cameras, joint: int) -> tuple[np.ndarray, np.ndarray]:
-    """``core.refine``'s reading of ``joint`` (centre shift, hinge axis) from the footage at
-    the capture's own poses ``truth`` (rotations, roots) of every frame of ``images``."""
+def at_capture(sk, images, truth, cameras, joints: list[int]) -> dict[int, Skeleton]:
+    """Per joint, ``sk`` with that joint where ``core.refine`` reads it (centre and hinge axis)
+    from the footage at the capture's own poses ``truth`` (rotations, roots) of every frame
+    of ``images``: one tracker, so each frame is read and filtered once."""
     poses = [BodyPose(R.copy(), p.copy(), [c.copy() for c in cameras]) for R, p in zip(*truth)]
-    return joint_from_track(Tracker(sk, images, "calibrated"), poses, range(len(poses)), joint)
+    tracker = Tracker(sk, images, "calibrated")
+    return {j: moved_joint(sk, j, *joint_from_track(tracker, poses, range(len(poses)), j))
+            for j in joints}
 
 
 def main(argv=None) -> int:
@@ -111,6 +115,7 @@ def main(argv=None) -> int:
     print("| joint | centre error before | after | axis error before | after | after, against"
           " the capture's own axis | read at the capture's poses |")
     print("|---|---|---|---|---|---|---|")
+    floors = at_capture(truth_sk, images, truth, job.cameras, [lk, rk])
     for j in (lk, rk):
         def centre(s, j=j):
             return 100 * np.linalg.norm(s.rest_positions[j] - truth_sk.rest_positions[j])
@@ -120,8 +125,7 @@ def main(argv=None) -> int:
             return min(a, 180 - a)  # a hinge axis has no sign
 
         own = capture_axis(truth[0][:, j])
-        shift, floor_axis = at_capture(truth_sk, images, truth, job.cameras, j)
-        floor = moved_joint(truth_sk, j, shift, floor_axis)
+        floor = floors[j]
         print(f"| {truth_sk.names[j]} | {centre(guess):.1f} cm | {centre(refined):.1f} cm |"
               f" {axis(guess):.1f}° | {axis(refined):.1f}° | {axis(refined, want=own):.1f}°"
               f" (job's axis: {axis(truth_sk, want=own):.1f}°) | {centre(floor):.1f} cm,"
