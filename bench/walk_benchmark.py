@@ -92,6 +92,7 @@ def main(argv=None) -> int:
     settings = json.loads(a.settings)
 
     results, refs, steps = {}, {}, {}
+    ref_of = {}  # run name -> its references' key in refs: (frame step, body)
     for name in a.runs.split(","):
         views, mode, step, joints = RUNS[name]
         job_path = write_job(a.cache, name.replace(" + ", "_").replace(" ", "_"), views, mode,
@@ -113,8 +114,9 @@ def main(argv=None) -> int:
         truth = (truth_all[0][sel], truth_all[1][sel])
         est = read_bvh(out).poses()
         results[name] = (evaluate.score(sk, tracked_names, est, truth), rep)
-        if (step, tuple(joints)) not in refs:
-            refs[step, tuple(joints)] = (
+        ref_of[name] = step, "best fit + spine" if joints is SPINE_JOINTS else "best fit"
+        if ref_of[name] not in refs:
+            refs[ref_of[name]] = (
                 evaluate.score(sk, tracked_names, evaluate.held_still(truth), truth),
                 evaluate.score(sk, tracked_names, evaluate.best_fit(sk, truth), truth),
             )
@@ -129,7 +131,7 @@ def main(argv=None) -> int:
           " held still | best fit | tracking fps | s / iteration |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name, (s, rep) in results.items():
-        still, best = refs[RUNS[name][2], tuple(RUNS[name][3])]
+        still, best = refs[ref_of[name]]
         first_div = rep["diverged_frames"][0] if rep["diverged_frames"] else None
         tracked = f"{rep['frames_tracked']}/{rep['frames_total']}" + (
             f" (diverged at {first_div})" if first_div is not None else "")
@@ -140,8 +142,7 @@ def main(argv=None) -> int:
     names = list(results)
     # the references at 15 fps (else the first rate run): held still, and each body's best fit
     step = 8 if any(k[0] == 8 for k in refs) else next(iter(refs))[0]
-    bests = {("best fit + spine" if len(body) > len(JOINTS) else "best fit"): ref[1]
-             for (st, body), ref in refs.items() if st == step}
+    bests = {body: ref[1] for (st, body), ref in refs.items() if st == step}
     still = next(ref[0] for (st, _), ref in refs.items() if st == step)
     fps = f" ({30 * 4 // step} fps)"
     print("| limb direction (°) | " + " | ".join(names) + f" | held still{fps} | "
