@@ -240,7 +240,9 @@ def skeleton_from_bvh(bvh: BvhFile) -> Skeleton:
 
 
 # --- templates -------------------------------------------------------------------------
-def _build(spec, end_sites=None) -> Skeleton:
+def _build(spec, end_sites=None, limits=None) -> Skeleton:
+    """A template from its joints (name, parent, offset, kind[, axis]), end sites and hinge
+    ``limits`` (name -> (lowest, highest) angle in degrees)."""
     names = [s[0] for s in spec]
     parents = [names.index(s[1]) if s[1] else -1 for s in spec]
     sk = Skeleton(
@@ -253,16 +255,20 @@ def _build(spec, end_sites=None) -> Skeleton:
         if end_sites
         else None,
     )
+    for name, range_deg in (limits or {}).items():
+        sk.limits[names.index(name)] = np.radians(range_deg)
     sk.blobs = sk.default_blobs()
     return sk
 
 
-def human_template() -> Skeleton:
+def human_template(lower_back: bool = False) -> Skeleton:
     """The paper's 19-DOF human, metres, y up, facing +z: 3-DOF hips, shoulders and neck,
-    1-DOF knees and elbows (flexion about local x)."""
+    1-DOF knees and elbows (flexion about local x), each limited to bend one way as anatomy
+    has it (knees 0 to 160 degrees, elbows -160 to 0). With ``lower_back`` the spine is a
+    ball too (22 DOF), so that the pelvis may turn against the chest as a walker's does."""
     spec = [
         ("Hips", None, (0, 0.95, 0), FIXED),
-        ("Spine", "Hips", (0, 0.1, 0), FIXED),
+        ("Spine", "Hips", (0, 0.1, 0), BALL if lower_back else FIXED),
         ("Chest", "Spine", (0, 0.3, 0), FIXED),
         ("Neck", "Chest", (0, 0.15, 0), BALL),
         ("LeftShoulder", "Chest", (0.18, 0.1, 0), BALL),
@@ -276,7 +282,10 @@ def human_template() -> Skeleton:
     ]
     ends = [None, None, None, (0, 0.25, 0), None, (0, -0.27, 0), None, (0, -0.27, 0), None,
             (0, -0.43, 0), None, (0, -0.43, 0)]
-    sk = _build(spec, ends)
+    # a knee turning +x swings its shank backward, an elbow turning -x its forearm forward
+    bends = {"LeftKnee": (0, 160), "RightKnee": (0, 160), "LeftElbow": (-160, 0),
+             "RightElbow": (-160, 0)}
+    sk = _build(spec, ends, bends)
     # an adult's widths (metres), in place of the length-based defaults
     radius = {"Hips": 0.13, "Spine": 0.13, "Chest": 0.11, "Neck": 0.09, "LeftShoulder": 0.045,
               "RightShoulder": 0.045, "LeftElbow": 0.04, "RightElbow": 0.04, "LeftHip": 0.08,
@@ -288,7 +297,8 @@ def human_template() -> Skeleton:
 
 def walker_template() -> Skeleton:
     """A 6-DOF frontoparallel walker seen from its side (+x is forward, y up, z toward the
-    camera): hinges at hips, knees and ankles, all about z."""
+    camera): hinges at hips, knees and ankles, all about z; the knees bend backward only
+    (-160 to 0 degrees: turning +z swings a shank forward)."""
     z = (0, 0, 1)
     spec = [
         ("Hips", None, (0, 0.95, 0), FIXED),
@@ -301,7 +311,7 @@ def walker_template() -> Skeleton:
         ("RightAnkle", "RightKnee", (0, -0.43, 0), HINGE, z),
     ]
     ends = [None, (0, 0.6, 0), None, None, (0.2, -0.05, 0), None, None, (0.2, -0.05, 0)]
-    return _build(spec, ends)
+    return _build(spec, ends, {"LeftKnee": (-160, 0), "RightKnee": (-160, 0)})
 
 
 def planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1)) -> Skeleton:

@@ -169,7 +169,8 @@ _CORE_TO_BLENDER = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
 def armature_from_skeleton(sk: Skeleton, name: str, collection):
     """A new armature object whose bones are the skeleton's joints (head at the joint, tail at
     its first child or end site), locked to the joint's kind: a hinge's free axis is the
-    bone's local z, aligned with the hinge axis; envelope radii are the blobs' radii."""
+    bone's local z, aligned with the hinge axis, and a limited hinge's range is that axis's
+    inverse-kinematics limit; envelope radii are the blobs' radii."""
     import bpy
     from mathutils import Vector
 
@@ -182,6 +183,7 @@ def armature_from_skeleton(sk: Skeleton, name: str, collection):
     T = _CORE_TO_BLENDER
     heads = sk.rest_positions @ T.T
     radius = {b.joint: float(np.mean(b.radii[1:])) for b in sk.blobs}
+    limits = {}  # hinge -> its range about the bone's z, which may point against its axis
     for j, joint in enumerate(sk.names):
         tips = [sk.offsets[c] for c in sk.children(j)] + list(sk.end_sites[j])
         tips = [t for t in tips if np.linalg.norm(t) > 1e-6]
@@ -192,6 +194,10 @@ def armature_from_skeleton(sk: Skeleton, name: str, collection):
             eb.parent = data.edit_bones[sk.names[sk.parents[j]]]
         if sk.kinds[j] == HINGE:
             eb.align_roll(Vector(T @ sk.axes[j]))
+            lo, hi = sk.limits[j]
+            if np.isfinite(lo) or np.isfinite(hi):
+                along = np.sign(np.dot(eb.z_axis, T @ sk.axes[j]))
+                limits[joint] = np.clip(sorted([along * lo, along * hi]), -np.pi, np.pi)
         eb.head_radius = eb.tail_radius = radius.get(j, 0.0)
     bpy.ops.object.mode_set(mode="OBJECT")
     for j, joint in enumerate(sk.names):
@@ -199,4 +205,7 @@ def armature_from_skeleton(sk: Skeleton, name: str, collection):
         kind = sk.kinds[j] if j else BALL
         pb.lock_rotation = {FIXED: (True,) * 3, HINGE: (True, True, False)}.get(kind, (False,) * 3)
         pb.rotation_mode = "XYZ" if kind == HINGE else "QUATERNION"
+        if joint in limits:
+            pb.use_ik_limit_z = True
+            pb.ik_min_z, pb.ik_max_z = limits[joint]
     return obj

@@ -125,13 +125,18 @@ class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
         return f"removed {n} tracked keyframes from '{arm.name}'"
 
 
+# name: (label, description, core template function, its arguments)
 TEMPLATES = {
-    "HUMAN": ("Human (19 degrees of freedom)", "Ball hips, shoulders and neck; hinge knees and "
-              "elbows", "human_template"),
+    "HUMAN": ("Human (19 degrees of freedom)", "The paper's body: ball hips, shoulders and "
+              "neck; hinge knees and elbows, bending one way", "human_template", {}),
+    "HUMAN_LOWER_BACK": ("Human, lower back free (22)", "The human with its spine a ball too, "
+                         "so that the pelvis turns against the chest: better for a walker "
+                         "seen in several views, worse in one", "human_template",
+                         {"lower_back": True}),
     "WALKER": ("Walker (6, from the side)", "Hinge hips, knees and ankles turning in the view's "
-               "plane", "walker_template"),
+               "plane", "walker_template", {}),
     "QUADRUPED": ("Quadruped (planar)", "Trunk, neck, head and four two-joint legs, all "
-                  "turning in the view's plane", "planar_quadruped_template"),
+                  "turning in the view's plane", "planar_quadruped_template", {}),
 }
 
 
@@ -149,10 +154,12 @@ class TWIST_OT_add_template_armature(bpy.types.Operator):
     def execute(self, context):
         from ..core import skeleton
 
-        sk = getattr(skeleton, TEMPLATES[self.template][2])()
+        _, _, build, kwargs = TEMPLATES[self.template]
+        sk = getattr(skeleton, build)(**kwargs)
         if context.object and context.object.mode != "OBJECT":
             bpy.ops.object.mode_set(mode="OBJECT")
-        arm = armature_from_skeleton(sk, self.template.title(), context.collection)
+        arm = armature_from_skeleton(sk, self.template.replace("_", " ").title(),
+                                     context.collection)
         context.scene.twist.armature = arm
         self.report({"INFO"}, f"added '{arm.name}': {len(sk.dof_names())} degrees of freedom")
         return {"FINISHED"}

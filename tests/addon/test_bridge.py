@@ -152,7 +152,7 @@ def test_bad_objects_are_refused_with_a_reason(bpy_module, addon):
         bridge.skeleton_from_armature(arm)
 
 
-@pytest.mark.parametrize("template", ["HUMAN", "WALKER", "QUADRUPED"])
+@pytest.mark.parametrize("template", ["HUMAN", "HUMAN_LOWER_BACK", "WALKER", "QUADRUPED"])
 def test_template_armatures_come_back_as_their_skeletons(bpy_module, registered, template):
     bpy = bpy_module
     from core import skeleton
@@ -161,8 +161,8 @@ def test_template_armatures_come_back_as_their_skeletons(bpy_module, registered,
     assert bpy.ops.twist.add_template_armature(template=template) == {"FINISHED"}
     arm = bpy.context.scene.twist.armature
     back = bridge.skeleton_from_armature(arm)
-    name = registered.twist_addon.operators.TEMPLATES[template][2]
-    core_sk = getattr(skeleton, name)()
+    _, _, name, kwargs = registered.twist_addon.operators.TEMPLATES[template]
+    core_sk = getattr(skeleton, name)(**kwargs)
     assert back.names == core_sk.names
     assert back.kinds[1:] == core_sk.kinds[1:]  # the root moves by its keys, not by a joint
     assert back.dof_names() == core_sk.dof_names()
@@ -172,6 +172,15 @@ def test_template_armatures_come_back_as_their_skeletons(bpy_module, registered,
     cj, ca = core_sk.dof_joints_and_axes()
     hinge = [k for k, j in enumerate(cj) if core_sk.kinds[j] == "hinge"]
     np.testing.assert_allclose(np.abs(da[hinge]), np.abs(ca[hinge] @ T.T), atol=1e-6)
+    for j in range(core_sk.n_joints):
+        if np.all(np.isinf(core_sk.limits[j])):
+            assert np.all(np.isinf(back.limits[j])), core_sk.names[j]
+            continue
+        # the same turns allowed: each end of the range as a rotation vector (the bone's
+        # axis may point against the template's)
+        ends = [sorted(map(tuple, np.round(np.outer(limits, axis), 6))) for limits, axis in
+                [(back.limits[j], back.axes[j]), (core_sk.limits[j], core_sk.axes[j] @ T.T)]]
+        assert ends[0] == ends[1], core_sk.names[j]
 
 
 def test_overlay_outlines_lie_on_the_projected_blobs(bpy_module, registered):

@@ -63,6 +63,35 @@ def test_templates_have_the_named_degrees_of_freedom():
         assert sk.blobs and all(np.all(b.radii > 0) for b in sk.blobs)
 
 
+def test_the_human_template_may_free_its_lower_back():
+    human = human_template(lower_back=True)
+    assert len(human.dof_names()) == 22
+    assert human.kinds[human.index("Spine")] == BALL
+    paper = human_template()
+    assert paper.kinds[paper.index("Spine")] != BALL
+
+
+@pytest.mark.parametrize("template, forward, bends", [
+    (human_template, (0, 0, 1), {"LeftKnee": -1, "RightKnee": -1, "LeftElbow": 1,
+                                 "RightElbow": 1}),
+    (walker_template, (1, 0, 0), {"LeftKnee": -1, "RightKnee": -1}),
+])
+def test_template_hinges_bend_the_way_anatomy_does(template, forward, bends):
+    # anywhere inside its limits a knee swings its shank behind it and an elbow its forearm
+    # in front (the hinge's end site seen from its joint, along the way the body faces)
+    sk = template()
+    limited = {sk.names[j] for j in range(sk.n_joints) if np.all(np.isfinite(sk.limits[j]))}
+    assert limited == set(bends)
+    for name, side in bends.items():
+        j = sk.index(name)
+        lo, hi = sk.limits[j]
+        assert hi - lo == pytest.approx(np.radians(160))
+        end = (list(sk.end_sites[j]) + [sk.offsets[c] for c in sk.children(j)])[0]
+        for angle in np.linspace(lo, hi, 9)[1:-1]:  # not straight
+            tip = se3.exp_so3(sk.axes[j] * angle) @ end
+            assert side * tip @ forward > 0, (name, np.degrees(angle))
+
+
 def test_a_planar_chain_stays_in_its_plane():
     chain = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
     R = np.tile(np.eye(3), (chain.n_joints, 1, 1))
