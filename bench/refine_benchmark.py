@@ -30,7 +30,14 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
-from walk_footage import JOINTS, SPINE_JOINTS, render, write_job  # noqa: E402
+from walk_footage import (  # noqa: E402
+    JOINTS,
+    SPINE_JOINTS,
+    add_spine_argument,
+    add_zoom_argument,
+    render,
+    write_job,
+)
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
@@ -79,9 +86,8 @@ def main(argv=None) -> int:
     ap.add_argument("--first", type=int, default=60)
     ap.add_argument("--last", type=int, help="one past the last frame (default: the end)")
     ap.add_argument("--rounds", type=int, default=10, help="track-and-refine rounds, at most")
-    ap.add_argument("--zoom", type=int, default=1, help="footage this many times 480x360")
-    ap.add_argument("--spine", action="store_true", help="track the lower back too (22 "
-                    "degrees of freedom instead of the paper's 19)")
+    add_zoom_argument(ap)
+    add_spine_argument(ap)
     a = ap.parse_args(argv)
     a.cache = a.cache or ROOT / ".cache" / ("walk" if a.zoom == 1 else f"walk{a.zoom}x")
     t0 = time.perf_counter()

@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
-from walk_footage import CAPTURE_FPS, JOINTS, SPINE_JOINTS, render, write_job  # noqa: E402
+from walk_footage import CAPTURE_FPS, JOINTS, SPINE_JOINTS, add_spine_argument, render, write_job  # noqa: E402
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
@@ -101,8 +101,7 @@ def main(argv=None) -> int:
     ap.add_argument("--windows", type=int, default=0, metavar="K",
                     help="short runs of K tracked frames from the true pose instead")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
-    ap.add_argument("--spine", action="store_true", help="track the lower back too (22 "
-                    "degrees of freedom instead of the paper's 19)")
+    add_spine_argument(ap)
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])

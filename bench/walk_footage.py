@@ -339,7 +339,7 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
         r = 0.0 if spec is False else float(np.mean(spec.get("radii", [spec.get("radius")])))
         eb.head_radius = eb.tail_radius = r
     bpy.ops.object.mode_set(mode="OBJECT")
-    scene.render.resolution_x, scene.render.resolution_y = 480, 360
+    scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
     scene.frame_start, scene.frame_end = 1, last_frame
     scene.twist.armature = arm
     rotations = camera_rotations()
@@ -373,6 +373,18 @@ def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list
     return path
 
 
+def add_zoom_argument(ap) -> None:
+    """``--zoom``: footage that many times the size, the same stage in more pixels."""
+    ap.add_argument("--zoom", type=int, default=1, help=f"footage this many times {WIDTH}x"
+                    f"{HEIGHT}")
+
+
+def add_spine_argument(ap) -> None:
+    """``--spine``: track SPINE_JOINTS instead of JOINTS."""
+    ap.add_argument("--spine", action="store_true", help="track the lower back too (22 "
+                    "degrees of freedom instead of the paper's 19)")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, required=True)
@@ -380,7 +392,7 @@ def main(argv=None) -> int:
     ap.add_argument("--last", type=int, default=772)
     ap.add_argument("--step", type=int, default=4, help="capture frames per rendered frame")
     ap.add_argument("--views", default="lateral,endon,oblique60")
-    ap.add_argument("--zoom", type=int, default=1, help="footage this many times 480x360")
+    add_zoom_argument(ap)
     a = ap.parse_args(argv)
     info = render(a.out, a.first, a.last, a.step, a.views.split(","), a.zoom)
     print(f"{len(info['frames'])} frames x {len(info['cameras'])} views in {a.out}"
