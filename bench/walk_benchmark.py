@@ -27,7 +27,15 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
-from walk_footage import CAPTURE_FPS, JOINTS, SPINE_JOINTS, render, write_job  # noqa: E402
+from walk_footage import (  # noqa: E402
+    CAPTURE_FPS,
+    HEIGHT,
+    JOINTS,
+    SPINE_JOINTS,
+    WIDTH,
+    render,
+    write_job,
+)
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
@@ -144,7 +152,7 @@ def main(argv=None) -> int:
     step = 8 if any(k[0] == 8 for k in refs) else next(iter(refs))[0]
     bests = {body: ref[1] for (st, body), ref in refs.items() if st == step}
     still = next(ref[0] for (st, _), ref in refs.items() if st == step)
-    fps = f" ({30 * 4 // step} fps)"
+    fps = f" ({CAPTURE_FPS // step} fps)"
     print("| limb direction (°) | " + " | ".join(names) + f" | held still{fps} | "
           + " | ".join(k + fps for k in bests) + " |")
     print("|---" * (len(names) + 2 + len(bests)) + "|")
@@ -169,7 +177,7 @@ def main(argv=None) -> int:
                   + " |")
         print("| mean of the eight limbs | " + " | ".join(
             f"{s.limb_mean_deg:.1f}" for s in steps.values()) + " |")
-    print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; 480x360 footage, "
+    print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; {WIDTH}x{HEIGHT} footage, "
           f"{len(JOINTS)} tracked joints (19 degrees of freedom), + spine "
           f"{len(SPINE_JOINTS)} (22)")
     return 0
