@@ -33,8 +33,9 @@ from walk_benchmark import RUNS  # noqa: E402
 from walk_footage import (  # noqa: E402
     JOINTS,
     SPINE_JOINTS,
+    add_footage_arguments,
     add_spine_argument,
-    add_zoom_argument,
+    footage_cache,
     render,
     write_job,
 )
@@ -81,15 +82,13 @@ def at_capture(sk, images, truth, cameras, joints: list[int]) -> dict[int, Skele
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cache", type=Path, help="footage folder (default: .cache/walk, or "
-                    ".cache/walk<zoom>x)")
     ap.add_argument("--first", type=int, default=60)
     ap.add_argument("--last", type=int, help="one past the last frame (default: the end)")
     ap.add_argument("--rounds", type=int, default=10, help="track-and-refine rounds, at most")
-    add_zoom_argument(ap)
+    add_footage_arguments(ap)
     add_spine_argument(ap)
     a = ap.parse_args(argv)
-    a.cache = a.cache or ROOT / ".cache" / ("walk" if a.zoom == 1 else f"walk{a.zoom}x")
+    a.cache = footage_cache(a)
     t0 = time.perf_counter()
     info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"], a.zoom)
     a.last = len(info["frames"]) if a.last is None else a.last

@@ -3,7 +3,7 @@ bench/walk_benchmark.py tracked from several first frames, forward and backward,
 scored against the capture, with their mean; or, with --windows K, many short runs that
 show how fast a limb is lost from the true pose, with far less spread than whole runs.
 
-    python bench/start_spread.py [--cache .cache/walk] [--quick | --windows K]
+    python bench/start_spread.py [--zoom 1] [--quick | --windows K]
                                  [--settings JSON] [--spine]
 
 A run starting on frame k of the 30 fps footage is posed there with the capture's pose; a
@@ -35,7 +35,16 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
-from walk_footage import CAPTURE_FPS, JOINTS, SPINE_JOINTS, add_spine_argument, render, write_job  # noqa: E402
+from walk_footage import (  # noqa: E402
+    CAPTURE_FPS,
+    JOINTS,
+    SPINE_JOINTS,
+    add_footage_arguments,
+    add_spine_argument,
+    footage_cache,
+    render,
+    write_job,
+)
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
@@ -96,15 +105,16 @@ def one_run(args: tuple) -> tuple[str, evaluate.Scores, int, float]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
+    add_footage_arguments(ap)
     ap.add_argument("--quick", action="store_true", help="eight runs instead of sixteen")
     ap.add_argument("--windows", type=int, default=0, metavar="K",
                     help="short runs of K tracked frames from the true pose instead")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     add_spine_argument(ap)
     a = ap.parse_args(argv)
+    a.cache = footage_cache(a)
     t0 = time.perf_counter()
-    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"])
+    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"], a.zoom)
     views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
     job_path = write_job(a.cache, "start_spread", views, mode, info["frames"], info["cameras"],
                          json.loads(a.settings), 4 / CAPTURE_FPS,

@@ -1,7 +1,7 @@
 """The tracking benchmark: rendered CMU walk, three Muybridge-style views, tracked through the
 command line, scored against the capture.
 
-    python bench/walk_benchmark.py [--cache .cache/walk] [--runs NAME,...]
+    python bench/walk_benchmark.py [--zoom 1] [--runs NAME,...] [--settings JSON]
 
 Renders the footage once (bench/walk_footage.py, cached), writes one job per run, runs
 ``python -m core track`` on each, and prints tables of limb-direction error, joint-position
@@ -33,6 +33,8 @@ from walk_footage import (  # noqa: E402
     JOINTS,
     SPINE_JOINTS,
     WIDTH,
+    add_footage_arguments,
+    footage_cache,
     render,
     write_job,
 )
@@ -85,14 +87,15 @@ def fmt(x, digits=1):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cache", type=Path, default=ROOT / ".cache" / "walk")
+    add_footage_arguments(ap)
     ap.add_argument("--first", type=int, default=300)
     ap.add_argument("--last", type=int, default=772)
     ap.add_argument("--runs", default=",".join(RUNS), help="comma-separated run names")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     a = ap.parse_args(argv)
+    a.cache = footage_cache(a)
     t0 = time.perf_counter()
-    info = render(a.cache, a.first, a.last, 4, THREE)
+    info = render(a.cache, a.first, a.last, 4, THREE, a.zoom)
     print(f"footage: {len(info['frames'])} frames x 3 views at 30 fps in {a.cache}"
           f" ({info['rendered']} rendered, {time.perf_counter() - t0:.0f} s)", flush=True)
     truth_bvh = read_bvh(a.cache / "truth.bvh")
@@ -177,7 +180,8 @@ def main(argv=None) -> int:
                   + " |")
         print("| mean of the eight limbs | " + " | ".join(
             f"{s.limb_mean_deg:.1f}" for s in steps.values()) + " |")
-    print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; {WIDTH}x{HEIGHT} footage, "
+    print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; {WIDTH * a.zoom}x"
+          f"{HEIGHT * a.zoom} footage, "
           f"{len(JOINTS)} tracked joints (19 degrees of freedom), + spine "
           f"{len(SPINE_JOINTS)} (22)")
     return 0

@@ -373,10 +373,18 @@ def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list
     return path
 
 
-def add_zoom_argument(ap) -> None:
-    """``--zoom``: footage that many times the size, the same stage in more pixels."""
+def add_footage_arguments(ap) -> None:
+    """``--zoom`` (footage that many times the size, the same stage in more pixels) and
+    ``--cache`` (where it is rendered); read them back with ``footage_cache``."""
     ap.add_argument("--zoom", type=int, default=1, help=f"footage this many times {WIDTH}x"
                     f"{HEIGHT}")
+    ap.add_argument("--cache", "--out", type=Path, help="footage folder (default: "
+                    ".cache/walk, or .cache/walk<zoom>x)")
+
+
+def footage_cache(args) -> Path:
+    """The footage folder the arguments of ``add_footage_arguments`` name."""
+    return args.cache or ROOT / ".cache" / ("walk" if args.zoom == 1 else f"walk{args.zoom}x")
 
 
 def add_spine_argument(ap) -> None:
@@ -387,15 +395,15 @@ def add_spine_argument(ap) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--first", type=int, default=300)
     ap.add_argument("--last", type=int, default=772)
     ap.add_argument("--step", type=int, default=4, help="capture frames per rendered frame")
     ap.add_argument("--views", default="lateral,endon,oblique60")
-    add_zoom_argument(ap)
+    add_footage_arguments(ap)
     a = ap.parse_args(argv)
-    info = render(a.out, a.first, a.last, a.step, a.views.split(","), a.zoom)
-    print(f"{len(info['frames'])} frames x {len(info['cameras'])} views in {a.out}"
+    out = footage_cache(a)
+    info = render(out, a.first, a.last, a.step, a.views.split(","), a.zoom)
+    print(f"{len(info['frames'])} frames x {len(info['cameras'])} views in {out}"
           f" ({info['rendered']} rendered now)")
     return 0
 
