@@ -54,6 +54,15 @@ class ImageSequence:
             self._grey[key] = self._read(view, frame)
         return self._grey[key]
 
+    def set_levels(self, levels: int) -> None:
+        """Build pyramids of ``levels`` levels from now on; those built already are dropped."""
+        if levels == self.levels:
+            return
+        for frame in list(self._ahead):
+            self._collect(frame)  # a reader still running would build the old number
+        self._pyramids.clear()
+        self.levels = levels
+
     def read_ahead(self, frame: int) -> None:
         """Start reading every view's ``frame`` and building its pyramids in the background."""
         if frame in self._ahead or all((c, frame) in self._pyramids

@@ -21,6 +21,7 @@ import numpy as np
 MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called foreground
 UNCOVERED_WEIGHT = 0.3  # of foreground no blob covers: parts the blobs lack (hands, feet)
 SLACK = 1.0  # level pixels of mismatch forgiven
+BODY_MARGIN = 6  # full-resolution pixels the key frame's body is painted out beyond its blobs
 STILL_AREA_RATIO = 4.0  # a backdrop holds while frames' foreground stays under this x body
 
 
@@ -36,7 +37,7 @@ class Backdrop:
     light)."""
 
     def __init__(self, grey: np.ndarray, body: np.ndarray, frames: Sequence[np.ndarray] = (),
-                 margin: int = 6):
+                 margin: int = BODY_MARGIN):
         grey = np.asarray(grey, np.float32)
         self.margin = margin
         self.unseen = self._widen(body)  # pixels whose backdrop is only painted in

@@ -45,6 +45,9 @@ from .solver import (
 
 SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
 BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
+# the body's height in the footage (pixels) that the pixel-sized settings are meant for: the
+# benchmark's 480x360 views, where they were measured, show it 205 pixels tall
+REFERENCE_BODY_PIXELS = 200.0
 
 
 def _knob(default, doc: str):
@@ -61,6 +64,11 @@ class TrackerSettings:
                             "pixels of each level (0: off)")
     iterations: int = _knob(3, "Gauss-Newton iterations per pyramid level, at most")
     pixel_step: int = _knob(2, "Use every n-th pixel across and down on the finest level")
+    auto_scale: bool = _knob(True, "A body in the footage twice as tall as about "
+                             f"{REFERENCE_BODY_PIXELS:g} pixels or more is tracked as if the "
+                             "footage were halved that many times, with its fine pixels "
+                             "sampled sparsely on added pyramid levels: the settings in "
+                             "pixels keep their meaning, and the speed holds")
     key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
                               "frame's: holds the track against drift")
     damping: float = _knob(1e-2, "Initial Levenberg-Marquardt damping")
@@ -98,6 +106,14 @@ class TrackerSettings:
         for name in ("levels", "iterations", "pixel_step"):
             if int(getattr(self, name)) < 1:
                 raise ValueError(f"settings.{name} must be a whole number >= 1")
+
+
+def body_octaves(skeleton: Skeleton, pose: BodyPose) -> int:
+    """How many times the body at ``pose`` is twice as tall in the footage as
+    ``REFERENCE_BODY_PIXELS`` (its rest pose's largest extent in its largest view, rounded in
+    octaves; 0 for a body no larger)."""
+    pixels = skeleton.height() * max(v.pose.s for v in pose.views)
+    return max(0, int(np.round(np.log2(pixels / REFERENCE_BODY_PIXELS))))
 
 
 @dataclass
@@ -180,6 +196,7 @@ class Tracker:
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
+        self._octaves = 0  # finer levels added to the settings' for a large body (auto_scale)
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
         self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
         self.n_dof = len(self._dof_joint)
@@ -207,7 +224,7 @@ class Tracker:
         self._learn_first_backdrops(key, key_frame)
         out = []
         g = self._grid(lv)
-        margin = s.silhouette_cap / 2**lv + 2 * g
+        margin = self._cap() / 2**lv + 2 * g
         for c in range(self.seq.n_views):
             if self._backdrops[c] is None:
                 out.append(None)
@@ -235,7 +252,8 @@ class Tracker:
         for c in range(self.seq.n_views):
             grey = self.seq.grey(c, key_frame)
             backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
-                self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})])
+                self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})],
+                sil.BODY_MARGIN * 2**self._octaves)
             if not backdrop.still:
                 self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
                                   "frame (a moving camera?), so its silhouette is not used")
@@ -264,14 +282,33 @@ class Tracker:
         searched, turned = self._search.run(est, [v.at_level(lv) for v in est.views], fgs)
         return searched if turned else est
 
+    def _scale_to(self, pose: BodyPose) -> None:
+        """Fit the pyramid to the body's size in the footage at ``pose`` (``auto_scale``);
+        what was built for another size is dropped."""
+        k = body_octaves(self.skeleton, pose) if self.settings.auto_scale else 0
+        if k != self._octaves:
+            self._octaves = k
+            self.seq.set_levels(self.settings.levels + k)
+            self._key_sets.clear()
+            self._backdrops, self._fg_cache = None, {}
+
+    def _n_levels(self) -> int:
+        return self.settings.levels + self._octaves
+
     def _search_level(self) -> int:
         """The level the limbs are searched on, after the coarser ones placed the body."""
-        return min(1, self.settings.levels - 1)
+        return min(1 + self._octaves, self._n_levels() - 1)
 
     def _grid(self, lv: int) -> int:
-        """Level pixels between the label map's samples: the fine level is looked at every
-        ``pixel_step`` pixels, like its point sets."""
-        return self.settings.pixel_step if lv == 0 else 1
+        """Level pixels between samples of a level's point sets and label maps: every
+        ``pixel_step``-th on the finest of the settings' levels, and as many full-resolution
+        pixels apart on the finer levels a large body adds."""
+        return self.settings.pixel_step * 2 ** (self._octaves - lv) if lv <= self._octaves \
+            else 1
+
+    def _cap(self) -> float:
+        """``silhouette_cap`` in full-resolution pixels of this footage."""
+        return self.settings.silhouette_cap * 2**self._octaves
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``."""
@@ -301,7 +338,7 @@ class Tracker:
     def _point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
                    set_weight: float) -> _PointSet:
         level = self.seq.pyramid(view, frame)[lv]
-        step = self.settings.pixel_step if lv == 0 else 1
+        step = self._grid(lv)
         v_l = pose.views[view].at_level(lv)
         pix_l, hits, _ = raycast.render_labels(
             v_l, self._blobs, kin.segments, level.shape, step
@@ -349,7 +386,7 @@ class Tracker:
         labels = [m[0] for m in maps]
         shape_cost, shape_parts = 0.0, []
         if fgs is not None:
-            cap = s.silhouette_cap / (2**lv * g)  # in map pixels
+            cap = self._cap() / (2**lv * g)  # in map pixels
             for (lab, idx, hits), view_fg in zip(maps, fgs):
                 if view_fg is None:
                     shape_parts.append(((), (), (), ()))
@@ -483,6 +520,7 @@ class Tracker:
         (view, segment joints (N,), scaled camera points q (N, 3), image gradients (N, 2),
         brightness residuals (N,), EM support weights (N,)). For estimates made outside the
         tracker's own system (the skeleton's refinement)."""
+        self._scale_to(prev)
         kin_prev, kin = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, est)
         levels = [self.seq.pyramid(c, frame)[0] for c in range(self.seq.n_views)]
         sets = [self._point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
@@ -500,12 +538,13 @@ class Tracker:
         ``prev_frame``) and the key frame, coarse to fine. Raises DegenerateSystem."""
         s = self.settings
         t0 = time.perf_counter()
+        self._scale_to(key)
         est = predicted
         offset = np.zeros(self.n_params)
         total_iters = 0
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
-        for lv in reversed(range(s.levels)):
+        for lv in reversed(range(self._n_levels())):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
             sets = []  # per view, the previous frame's points then the key frame's
             for c in range(self.seq.n_views):
@@ -606,6 +645,7 @@ class Tracker:
         key_frame, key = frames[0], initial
         self._key_sets.clear()  # the key pose may differ from an earlier run's
         self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it
+        self._scale_to(initial)
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
         yield first
         history = [first]

@@ -4,10 +4,18 @@ import numpy as np
 import pytest
 
 from core import se3
+from core.camera import View
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.skeleton import human_template
-from core.tracker import Tracker, TrackerSettings, _PointSet, track
+from core.tracker import (
+    REFERENCE_BODY_PIXELS,
+    Tracker,
+    TrackerSettings,
+    _PointSet,
+    body_octaves,
+    track,
+)
 from support.synthetic import render, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
@@ -77,6 +85,59 @@ def test_recovers_a_known_small_motion_in_three_views(body, mode):
         for v, t in zip(est.views, moved.views):
             err = np.abs(v.project(sk.rest_positions) - t.project(sk.rest_positions)).max()
             assert err < 0.3  # pixels
+
+
+def _enlarged(pose: BodyPose, factor: float) -> BodyPose:
+    """The same pose seen by the same cameras on footage ``factor`` times the size (pixel
+    i of the original is pixel factor * i of the new one, as a pyramid level is)."""
+    return BodyPose(pose.rotations, pose.root_position, [
+        View(se3.Similarity(factor * v.pose.s, v.pose.R, v.pose.t), factor * v.center)
+        for v in pose.views])
+
+
+def test_the_body_octaves_count_doublings_of_its_height_in_the_footage(body):
+    sk, pose = body
+    px = sk.height() * max(v.pose.s for v in pose.views)
+    for times, octaves in [(0.4, 0), (1.3, 0), (1.5, 1), (2.0, 1), (2.7, 1), (3.0, 2),
+                           (4.0, 2), (8.0, 3)]:
+        assert body_octaves(sk, _enlarged(pose, times * REFERENCE_BODY_PIXELS / px)) == octaves
+    small, large = _enlarged(pose, 1.0), _enlarged(pose, 1.0)
+    large.views[1] = _enlarged(pose, 4 * REFERENCE_BODY_PIXELS / px).views[1]
+    assert body_octaves(sk, small) == 0 and body_octaves(sk, large) == 2  # the largest view
+
+
+def test_a_body_twice_as_large_is_sampled_and_tracked_as_at_its_own_size(body):
+    """Footage twice the size gets a pyramid level more, on which the body's points are as
+    many as on the original's finest level; its own finest level is sampled as sparsely. The
+    known small motion is recovered as well as at the original size."""
+    sk, pose = body
+    pose = BodyPose(pose.rotations, pose.root_position, pose.views[:2])
+    moved = apply_update(sk, pose, _small_motion(sk, CALIBRATED, 2, seed=4), CALIBRATED)
+    big, moved_big = _enlarged(pose, 2.0), _enlarged(moved, 2.0)
+    assert body_octaves(sk, pose) == 0 and body_octaves(sk, big) == 1
+    frames = [[render(sk, big, c, shape=(720, 640)),
+               render(sk, moved_big, c, shape=(720, 640), noise=0.01, seed=c)]
+              for c in range(2)]
+    small_frames = [[render(sk, pose, c)] for c in range(2)]
+
+    def points(tracker, p, lv):
+        tracker._scale_to(p)
+        return len(tracker._point_set(p, Kinematics(sk, p), 0, 0, lv, 1.0).value)
+
+    small = Tracker(sk, small_frames, CALIBRATED)
+    scaled = Tracker(sk, frames, CALIBRATED)
+    fixed = Tracker(sk, frames, CALIBRATED, TrackerSettings(auto_scale=False))
+    for lv in range(3):  # the original's levels are the large footage's next ones up
+        assert points(scaled, big, lv + 1) == pytest.approx(points(small, pose, lv), rel=0.05)
+    assert points(scaled, big, 0) == pytest.approx(points(small, pose, 0), rel=0.05)
+    assert points(fixed, big, 0) > 3.5 * points(small, pose, 0)
+    assert scaled.seq.levels == 4 and fixed.seq.levels == 3
+
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10)), big, [0, 1])
+    after = _limb_errors(sk, res.frames[1].pose, moved_big)
+    assert _limb_errors(sk, big, moved_big).max() > 2.0  # the motion is real
+    assert after.max() < 0.5, after
+    assert np.linalg.norm(res.frames[1].pose.root_position - moved.root_position) < 2e-3
 
 
 def test_constant_velocity_prediction_continues_a_steady_motion(body):
