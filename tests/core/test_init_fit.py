@@ -79,7 +79,7 @@ def _clicks(true_sk, R, p, views, rng, noise=1.0):
 
 
 @pytest.mark.parametrize("mode", [CALIBRATED, INDEPENDENT])
-@pytest.mark.parametrize("noise, seed", [(0.0, 0), (1.0, 0), (1.0, 5)])
+@pytest.mark.parametrize("noise, seed", [(0.0, 0), (1.0, 0), (1.0, 5), (2.0, 0)])
 def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, noise, seed):
     b, guess_sk = _body(cmu_walk)
     rng = np.random.default_rng(seed)
@@ -126,10 +126,12 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
     # 1.9 degrees RMS at 1 px, the other limbs 0.4-1.7, so a 2-degree bound on every limb of
     # every seed is more than these clicks hold. Lengths over the same seeds: within 1.4 %
     # (calibrated); independent views fit the body's size freely (0-19 % over) but its
-    # proportions within 1 %
-    assert np.mean(errs) < 1.5 and np.max(errs) < 3.0, errs
-    assert np.max(np.abs(ratio - 1)) < 0.02, lens
-    assert res.residual_px < 2
+    # proportions within 1 %. The errors grow with the noise: at 2 px over the same seeds,
+    # mean 1.4 (calibrated) and 1.8 (independent) degrees, worst limb 1.9-5.5, lengths and
+    # proportions within 2.6 %
+    assert np.mean(errs) < 1.5 * noise and np.max(errs) < 3.0 * noise, errs
+    assert np.max(np.abs(ratio - 1)) < 0.02 * noise, lens
+    assert res.residual_px < 2 * noise
 
 
 def test_one_view_with_known_lengths_recovers_each_clicked_limb_up_to_its_mirror_in_depth(
