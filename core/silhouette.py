@@ -22,6 +22,8 @@ MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called f
 UNCOVERED_WEIGHT = 0.3  # of foreground no blob covers: parts the blobs lack (hands, feet)
 SLACK = 1.0  # level pixels of mismatch forgiven
 BODY_MARGIN = 6  # full-resolution pixels the key frame's body is painted out beyond its blobs
+INPAINT_RADIUS = 6  # pixels around a painted-out pixel its value is drawn from (the cost
+# grows with its square: at the margin of a body 800 pixels tall, 24, it took 2 s a view)
 STILL_AREA_RATIO = 4.0  # a backdrop holds while frames' foreground stays under this x body
 
 
@@ -42,7 +44,7 @@ class Backdrop:
         self.margin = margin
         self.unseen = self._widen(body)  # pixels whose backdrop is only painted in
         img8 = np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8)
-        self.image = cv2.inpaint(img8, self.unseen.astype(np.uint8), margin,
+        self.image = cv2.inpaint(img8, self.unseen.astype(np.uint8), INPAINT_RADIUS,
                                  cv2.INPAINT_TELEA).astype(np.float32) / 255
         noise = np.abs(grey - cv2.medianBlur(grey, 3))[~self.unseen]
         self.threshold = max(MIN_CONTRAST, 6 * 1.4826 * float(np.median(noise)))

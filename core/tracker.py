@@ -311,8 +311,12 @@ class Tracker:
         return self.settings.silhouette_cap * 2**self._octaves
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
-        """Full-resolution pixels the blobs cover at ``pose`` in ``view``."""
-        return self._label_map(pose, kin, view, shape, 0, 1)[0] >= 0
+        """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
+        (``auto_scale``) each block of 2^octaves pixels as its first pixel, which the
+        backdrop's margin (as many times wider) covers."""
+        g = 2**self._octaves
+        covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
+        return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 
     def _learn_backdrops(self, res: FrameResult) -> None:
         """Let each view's backdrop see behind where the body was on an earlier frame, now
