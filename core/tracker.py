@@ -64,11 +64,11 @@ class TrackerSettings:
                             "pixels of each level (0: off)")
     iterations: int = _knob(3, "Gauss-Newton iterations per pyramid level, at most")
     pixel_step: int = _knob(2, "Use every n-th pixel across and down on the finest level")
-    auto_scale: bool = _knob(True, "A body in the footage twice as tall as about "
-                             f"{REFERENCE_BODY_PIXELS:g} pixels or more is tracked as if the "
-                             "footage were halved that many times, with its fine pixels "
-                             "sampled sparsely on added pyramid levels: the settings in "
-                             "pixels keep their meaning, and the speed holds")
+    auto_scale: bool = _knob(True, "Fit the settings counted in pixels to the body's size: "
+                             "a body over about 280 pixels tall in the footage is tracked as "
+                             "if the footage were halved once per doubling over "
+                             f"{REFERENCE_BODY_PIXELS:g}, with its finer pixels sampled "
+                             "sparsely on added pyramid levels (faster, and steadier)")
     key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
                               "frame's: holds the track against drift")
     damping: float = _knob(1e-2, "Initial Levenberg-Marquardt damping")
