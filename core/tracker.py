@@ -14,7 +14,9 @@ the EM support posterior. With still cameras, the blobs' outline is also held ag
 body's silhouette (``silhouette``): chamfer pulls in both directions whose reach is a limb's
 length, not a blob's width, so that a fast limb is caught and a lost one found again. A frame
 whose residual jumps, whose body leaves the images or whose system is degenerate is reported
-as diverged instead of being accepted.
+as diverged instead of being accepted. Sizes in pixels are meant for a body about
+``REFERENCE_BODY_PIXELS`` tall; a body several times that gets finer pyramid levels on top,
+sampled as sparsely (``auto_scale``).
 """
 
 from __future__ import annotations
@@ -312,8 +314,8 @@ class Tracker:
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
-        (``auto_scale``) each block of 2^octaves pixels as its first pixel, which the
-        backdrop's margin (as many times wider) covers."""
+        (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
+        an error the backdrop's margin (as many times wider) covers."""
         g = 2**self._octaves
         covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
