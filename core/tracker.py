@@ -294,12 +294,9 @@ class Tracker:
             self._key_sets.clear()
             self._backdrops, self._fg_cache = None, {}
 
-    def _n_levels(self) -> int:
-        return self.settings.levels + self._octaves
-
     def _search_level(self) -> int:
         """The level the limbs are searched on, after the coarser ones placed the body."""
-        return min(1 + self._octaves, self._n_levels() - 1)
+        return min(1 + self._octaves, self.seq.levels - 1)
 
     def _grid(self, lv: int) -> int:
         """Level pixels between samples of a level's point sets and label maps: every
@@ -550,7 +547,7 @@ class Tracker:
         total_iters = 0
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
-        for lv in reversed(range(self._n_levels())):
+        for lv in reversed(range(self.seq.levels)):
             levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
             sets = []  # per view, the previous frame's points then the key frame's
             for c in range(self.seq.n_views):
