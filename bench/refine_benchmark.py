@@ -31,12 +31,11 @@ sys.path.insert(0, str(ROOT / "bench"))
 import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
 from walk_footage import (  # noqa: E402
-    JOINTS,
-    SPINE_JOINTS,
     add_footage_arguments,
     add_spine_argument,
     footage_cache,
     render,
+    tracked_joints,
     write_job,
 )
 
@@ -90,14 +89,14 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     a.cache = footage_cache(a)
     t0 = time.perf_counter()
-    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"], a.zoom)
+    views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
+    info = render(a.cache, 300, 772, 4, views, a.zoom)
     a.last = len(info["frames"]) if a.last is None else a.last
     if not 0 <= a.first < a.last - 2 or a.last > len(info["frames"]):
         ap.error(f"--first {a.first} --last {a.last}: the footage has frames 0-"
                  f"{len(info['frames']) - 1}; give at least three, with --last one past them")
-    views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
     job = load_job(write_job(a.cache, "refine", views, mode, info["frames"], info["cameras"],
-                             {}, 4 / 120, SPINE_JOINTS if a.spine else JOINTS))
+                             {}, 4 / 120, tracked_joints(a)))
     truth_sk = job.skeleton
     T = read_bvh(a.cache / "truth.bvh").poses()
     sel = slice(a.first, a.last)

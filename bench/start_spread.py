@@ -37,12 +37,11 @@ import evaluate  # noqa: E402
 from walk_benchmark import RUNS  # noqa: E402
 from walk_footage import (  # noqa: E402
     CAPTURE_FPS,
-    JOINTS,
-    SPINE_JOINTS,
     add_footage_arguments,
     add_spine_argument,
     footage_cache,
     render,
+    tracked_joints,
     write_job,
 )
 
@@ -114,11 +113,11 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     a.cache = footage_cache(a)
     t0 = time.perf_counter()
-    info = render(a.cache, 300, 772, 4, ["lateral", "endon", "oblique60"], a.zoom)
     views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
+    info = render(a.cache, 300, 772, 4, views, a.zoom)
     job_path = write_job(a.cache, "start_spread", views, mode, info["frames"], info["cameras"],
                          json.loads(a.settings), 4 / CAPTURE_FPS,
-                         SPINE_JOINTS if a.spine else JOINTS)
+                         tracked_joints(a))
     runs = windows(a.windows) if a.windows else starts(a.quick)
     given = 2 if a.windows else 1
     with Pool(2) as pool:

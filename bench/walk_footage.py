@@ -388,9 +388,15 @@ def footage_cache(args) -> Path:
 
 
 def add_spine_argument(ap) -> None:
-    """``--spine``: track SPINE_JOINTS instead of JOINTS."""
+    """``--spine``: track SPINE_JOINTS instead of JOINTS; read it back with
+    ``tracked_joints``."""
     ap.add_argument("--spine", action="store_true", help="track the lower back too (22 "
                     "degrees of freedom instead of the paper's 19)")
+
+
+def tracked_joints(args) -> dict:
+    """The joints the argument of ``add_spine_argument`` asks to track."""
+    return SPINE_JOINTS if args.spine else JOINTS
 
 
 def main(argv=None) -> int:
