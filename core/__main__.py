@@ -41,6 +41,8 @@ def _track(args) -> int:
     write_bvh(result_bvh(job, result), args.out)
     if args.report:
         write_report(args.report, report(job, result, seconds))
+    for note in result.notes:
+        print(f"note: {note}", file=sys.stderr)
     n = len(result.frames)
     print(f"tracked {n} of {len(job.images[0])} frames in {seconds:.1f} s -> {args.out}",
           file=sys.stderr)

@@ -33,7 +33,7 @@ from . import silhouette as sil
 from .blas import one_blas_thread
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
-from .search import LimbSearch
+from .search import SIDE_ON, LimbSearch
 from .sequence import ImageSequence
 from .skeleton import HINGE, Skeleton
 from .solver import (
@@ -50,6 +50,7 @@ BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop be
 # the body's height in the footage (pixels) that the pixel-sized settings are meant for: the
 # benchmark's 480x360 views, where they were measured, show it 205 pixels tall
 REFERENCE_BODY_PIXELS = 200.0
+ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
 
 
 def _knob(default, doc: str):
@@ -116,6 +117,22 @@ def body_octaves(skeleton: Skeleton, pose: BodyPose) -> int:
     octaves; 0 for a body no larger)."""
     pixels = skeleton.height() * max(v.pose.s for v in pose.views)
     return max(0, int(np.round(np.log2(pixels / REFERENCE_BODY_PIXELS))))
+
+
+def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
+    """Names of the tracked joints that turn their limbs toward or away from the cameras
+    when every view looks along one line (one view, or views within 15 degrees of it): the
+    footage shows such a turn only as foreshortening, the same for either sign. A ball joint
+    is always one; a hinge is not when its axis at ``pose`` lies within 25 degrees of the
+    line of sight (it turns in the image plane). Empty when the views look different ways."""
+    sight = [v.pose.R[2] for v in pose.views]
+    if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
+        return []
+    frames = Kinematics(skeleton, pose).frames
+    dof_joints = sorted(set(skeleton.dof_joints_and_axes()[0].tolist()))
+    return [skeleton.names[j] for j in dof_joints
+            if skeleton.kinds[j] != HINGE
+            or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON]
 
 
 @dataclass
@@ -648,6 +665,12 @@ class Tracker:
         key_frame, key = frames[0], initial
         self._key_sets.clear()  # the key pose may differ from an earlier run's
         self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it
+        blind = depth_blind_joints(self.skeleton, initial)
+        if blind:
+            self.notes.append(
+                f"every view looks along one line, so {', '.join(blind)} can turn toward or "
+                "away from the camera unseen (only foreshortening shows it): add a view from "
+                "another side, or track them as hinges about the line of sight")
         self._scale_to(initial)
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
         yield first

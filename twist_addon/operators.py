@@ -64,6 +64,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
         result.last_residual = tracked[-1].residual if len(tracked) > 1 else 0.0
         result.diverged_frames = ", ".join(
             f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
+        result.notes = "\n".join(self._session.tracker.notes)
         context.scene.frame_set(context.scene.frame_current)
         return {"FINISHED"}
 

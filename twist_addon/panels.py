@@ -5,12 +5,14 @@ retargeting bone map folded away)."""
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 
 import bpy
 
 from ..core.tracker import TrackerSettings
 
 _MAIN_SETTINGS = ("levels", "iterations", "key_weight")
+NOTE_WIDTH = 40  # characters a line of the Results panel's notes (the sidebar's own width)
 
 
 class TWIST_UL_views(bpy.types.UIList):
@@ -118,6 +120,10 @@ class TWIST_PT_results(_TwistPanel, bpy.types.Panel):
         layout.prop(result, "last_residual")
         if result.diverged_frames:
             layout.label(text="Stopped at frame " + result.diverged_frames, icon="ERROR")
+        for note in result.notes.splitlines():
+            col = layout.column(align=True)
+            for i, line in enumerate(textwrap.wrap(note, NOTE_WIDTH)):
+                col.label(text=line, icon="INFO" if i == 0 else "BLANK1")
 
 
 class TWIST_PT_animation(_TwistPanel, bpy.types.Panel):

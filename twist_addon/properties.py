@@ -100,6 +100,9 @@ class TWIST_PG_result(bpy.types.PropertyGroup):
         description="RMS brightness error of the last tracked frame (0 to 1)")
     diverged_frames: bpy.props.StringProperty(
         name="Diverged", description="Frames where the last run stopped, and why")
+    notes: bpy.props.StringProperty(
+        name="Notes", description="What the tracker noted about the last run, one note a "
+        "line (a view whose backdrop moves, joints one line of sight cannot see turn)")
 
 
 class TWIST_PG_scene(bpy.types.PropertyGroup):

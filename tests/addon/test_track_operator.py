@@ -14,6 +14,7 @@ from walk_footage import JOINTS, render, tracking_scene  # noqa: E402
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
+from support.layout import draw_panel  # noqa: E402
 
 VIEWS = ["lateral", "endon", "oblique60"]
 TRACKED = list(JOINTS)
@@ -78,6 +79,27 @@ def test_track_keys_exactly_the_tracked_bones_and_frames(bpy_module, registered,
             ga, gb = got[sk.index(a)], got[sk.index(b)]
             err = np.degrees(se3.angle_between_vectors(gb - ga, want[b] - want[a]))
             assert err < 8.0, (f, a, err)  # measured: at most 6.1 (knees as balls here)
+
+
+def test_one_view_tracks_and_notes_the_joints_it_cannot_see_turn_in_depth(bpy_module,
+                                                                          registered, footage):
+    """Track's note on one line of sight reaches the scene's result, and the Results panel
+    shows it; three views leave no note."""
+    bpy = bpy_module
+    _scene(bpy, registered, footage)
+    scene = bpy.context.scene
+    scene.frame_end = 3
+    assert bpy.ops.twist.track() == {"FINISHED"} and scene.twist.result.notes == ""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    tracking_scene(bpy, footage, VIEWS[:1], 3)
+    scene = bpy.context.scene
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    assert scene.twist.result.frames_tracked == 2
+    notes = scene.twist.result.notes.splitlines()
+    assert len(notes) == 1 and all(bone in notes[0] for bone in TRACKED)
+    panel = registered.twist_addon.panels.TWIST_PT_results
+    lines = [k["text"] for name, _, k in draw_panel(bpy, panel) if name == "label"]
+    assert " ".join(lines) == notes[0]  # wrapped into the sidebar's lines, nothing lost
 
 
 def _bvh_world(bvh, R, p):

@@ -1,36 +1,10 @@
 """The sidebar panels drawn into a recording stand-in layout, and adding and removing views."""
 
-import types
-
 import cv2
 import numpy as np
 import pytest
 
-
-class Recorder:
-    """Stands in for a UILayout: records what is drawn, and sub-layouts record into it too."""
-
-    def __init__(self, calls=None):
-        self.calls = [] if calls is None else calls
-
-    def __getattr__(self, name):
-        if name in ("row", "column", "box", "split", "grid_flow", "column_flow"):
-            return lambda *a, **k: Recorder(self.calls)
-        def record(*a, **k):
-            self.calls.append((name, a, k))
-            return types.SimpleNamespace()  # what operator() gives: properties to set
-
-        return record
-
-    def __setattr__(self, name, value):
-        if name == "calls":
-            object.__setattr__(self, name, value)
-
-
-def _draw(bpy, panel_cls):
-    rec = Recorder()
-    panel_cls.draw(types.SimpleNamespace(layout=rec), bpy.context)
-    return rec.calls
+from support.layout import draw_panel
 
 
 def test_panels_draw_existing_properties_and_operators(bpy_module, registered, tmp_path):
@@ -45,7 +19,7 @@ def test_panels_draw_existing_properties_and_operators(bpy_module, registered, t
         if not issubclass(cls, bpy.types.Panel):
             continue
         assert cls.poll(bpy.context) if hasattr(cls, "poll") else True
-        for name, args, _ in _draw(bpy, cls):
+        for name, args, _ in draw_panel(bpy, cls):
             if name == "prop":
                 data, prop = args[0], args[1]
                 assert prop in data.bl_rna.properties, (cls.__name__, prop)

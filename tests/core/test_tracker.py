@@ -7,13 +7,14 @@ from core import se3
 from core.camera import View
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
-from core.skeleton import human_template
+from core.skeleton import HINGE, human_template
 from core.tracker import (
     REFERENCE_BODY_PIXELS,
     Tracker,
     TrackerSettings,
     _PointSet,
     body_octaves,
+    depth_blind_joints,
     track,
 )
 from support.synthetic import render, side_view
@@ -277,6 +278,34 @@ def test_a_planar_chain_seen_from_the_side_is_tracked_in_one_view():
     # image of the chain is determined, and it is what is compared
     assert np.abs(joint_pixels(pose) - joint_pixels(moved)).max() > 15
     assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 0.5
+    assert res.notes == []  # every hinge turns in the image plane: nothing to warn of
+
+
+def test_a_note_names_the_joints_that_turn_in_depth_when_the_views_share_a_line_of_sight(
+        body):
+    """Seen along the knees' and elbows' axes, only the ball joints turn limbs in depth; seen
+    from the front, every tracked joint; from three sides, none. Views 10 degrees apart
+    count as one line of sight, and a run with one view says which joints in its notes."""
+    sk, pose = body
+    names = sk.tracked_joint_names()
+    balls = [n for n in names if sk.kinds[sk.index(n)] != HINGE]
+    assert 0 < len(balls) < len(names)
+
+    def seen_by(*yaws):
+        return BodyPose(pose.rotations, pose.root_position,
+                        [side_view(yaw_deg=y) for y in yaws])
+
+    assert depth_blind_joints(sk, seen_by(90)) == balls  # the hinges' axes point at it
+    assert depth_blind_joints(sk, seen_by(90, 100)) == balls
+    assert depth_blind_joints(sk, seen_by(0)) == names
+    assert depth_blind_joints(sk, seen_by(90, 70)) == []
+    assert depth_blind_joints(sk, pose) == []
+    one = seen_by(0)
+    frames = [[render(sk, one, 0), render(sk, one, 0, noise=0.01)]]
+    notes = track(Tracker(sk, frames, CALIBRATED), one, [0, 1]).notes
+    assert len(notes) == 1 and all(n in notes[0] for n in names)
+    three = [[render(sk, pose, c)] * 2 for c in range(3)]
+    assert track(Tracker(sk, three, CALIBRATED), pose, [0, 1]).notes == []
 
 
 def test_a_hinge_is_held_within_its_limits(body):
