@@ -3,7 +3,7 @@ bench/walk_benchmark.py tracked from several first frames, forward and backward,
 scored against the capture, with their mean; or, with --windows K, many short runs that
 show how fast a limb is lost from the true pose, with far less spread than whole runs.
 
-    python bench/start_spread.py [--zoom 1] [--quick | --windows K]
+    python bench/start_spread.py [--zoom 1 [--zoomed VIEW,...]] [--quick | --windows K]
                                  [--settings JSON] [--spine]
 
 A run starting on frame k of the 30 fps footage is posed there with the capture's pose; a
@@ -16,6 +16,9 @@ A window of K frames starts from the capture's pose on its first two frames (the
 given as a user's correction: the key frame, and the velocity known) and tracks K more: 15 fps
 forward from every 8th frame and backward from every 8th, 30 fps forward from every 12th
 (38 windows for K = 6). Scored on the tracked frames only, and on each window's last.
+
+With --zoomed, only the named views come from the --zoom footage and the others from the
+480x360 one: views of different sizes in one job.
 """
 
 from __future__ import annotations
@@ -110,14 +113,31 @@ def main(argv=None) -> int:
                     help="short runs of K tracked frames from the true pose instead")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     add_spine_argument(ap)
+    ap.add_argument("--zoomed", default="", metavar="VIEW,...",
+                    help="only these views from the --zoom footage, the rest at 480x360")
     a = ap.parse_args(argv)
     a.cache = footage_cache(a)
     t0 = time.perf_counter()
     views, mode, _, _ = RUNS["3 views calibrated 30 fps"]
     info = render(a.cache, 300, 772, 4, views, a.zoom)
+    zoomed = [v for v in a.zoomed.split(",") if v]
+    if set(zoomed) - set(views):
+        ap.error(f"--zoomed: the views are {', '.join(views)}")
+    if zoomed:  # the job lives with the small footage and reaches into the zoomed one
+        zoomed_cache, zoomed_cameras = a.cache, info["cameras"]
+        a.cache = footage_cache(argparse.Namespace(zoom=1, cache=None))
+        info = render(a.cache, 300, 772, 4, views, 1)
     job_path = write_job(a.cache, "start_spread", views, mode, info["frames"], info["cameras"],
                          json.loads(a.settings), 4 / CAPTURE_FPS,
                          tracked_joints(a))
+    if zoomed:
+        job = json.loads(job_path.read_text())
+        for name, view in zip(views, job["views"]):
+            if name in zoomed:
+                view["images"] = [str(zoomed_cache / name / Path(p).name)
+                                  for p in view["images"]]
+                view["camera"] = zoomed_cameras[name]
+        job_path.write_text(json.dumps(job, indent=1))
     runs = windows(a.windows) if a.windows else starts(a.quick)
     given = 2 if a.windows else 1
     with Pool(2) as pool:

@@ -19,11 +19,12 @@ from . import image as imagelib
 
 class ImageSequence:
     """``images[view][frame]`` is a path or an array; grey images are float32 (H, W) in
-    [0, 1], pyramids finest level first (``core.image.pyramid``)."""
+    [0, 1], pyramids finest level first (``core.image.pyramid``), ``levels[view]`` levels
+    each (``levels`` given as one number for every view)."""
 
     def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0):
         self.images = images
-        self.levels = levels
+        self.levels = [levels] * len(images)
         self.highpass = highpass
         self._pyramids: dict[tuple[int, int], list[imagelib.Level]] = {}  # (view, frame)
         self._grey: dict[tuple[int, int], np.ndarray] = {}
@@ -42,7 +43,7 @@ class ImageSequence:
         if key not in self._pyramids:
             self._collect(frame)
         if key not in self._pyramids:
-            self._pyramids[key] = self._build(self.grey(view, frame))
+            self._pyramids[key] = self._build(view, self.grey(view, frame))
         return self._pyramids[key]
 
     def grey(self, view: int, frame: int) -> np.ndarray:
@@ -54,14 +55,15 @@ class ImageSequence:
             self._grey[key] = self._read(view, frame)
         return self._grey[key]
 
-    def set_levels(self, levels: int) -> None:
-        """Build pyramids of ``levels`` levels from now on; those built already are dropped."""
-        if levels == self.levels:
+    def set_levels(self, levels: Sequence[int]) -> None:
+        """Build each view's pyramids with ``levels[view]`` levels from now on; those built
+        already are dropped."""
+        if list(levels) == self.levels:
             return
         for frame in list(self._ahead):
             self._collect(frame)  # a reader still running would build the old number
         self._pyramids.clear()
-        self.levels = levels
+        self.levels = list(levels)
 
     def read_ahead(self, frame: int) -> None:
         """Start reading every view's ``frame`` and building its pyramids in the background."""
@@ -69,8 +71,8 @@ class ImageSequence:
                                        for c in range(self.n_views)):
             return
         self._ahead[frame] = self._reader.submit(
-            lambda: [(g, self._build(g)) for g in
-                     (self._read(c, frame) for c in range(self.n_views))])
+            lambda: [(g, self._build(c, g)) for c, g in
+                     ((c, self._read(c, frame)) for c in range(self.n_views))])
 
     def keep_only(self, keys: set[tuple[int, int]]) -> None:
         """Forget every (view, frame) not in ``keys``; frames being read ahead stay."""
@@ -91,5 +93,5 @@ class ImageSequence:
         src = self.images[view][frame]
         return imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
 
-    def _build(self, grey: np.ndarray) -> list[imagelib.Level]:
-        return imagelib.pyramid(grey, self.levels, highpass=self.highpass)
+    def _build(self, view: int, grey: np.ndarray) -> list[imagelib.Level]:
+        return imagelib.pyramid(grey, self.levels[view], highpass=self.highpass)

@@ -15,8 +15,9 @@ body's silhouette (``silhouette``): chamfer pulls in both directions whose reach
 length, not a blob's width, so that a fast limb is caught and a lost one found again. A frame
 whose residual jumps, whose body leaves the images or whose system is degenerate is reported
 as diverged instead of being accepted. Sizes in pixels are meant for a body about
-``REFERENCE_BODY_PIXELS`` tall; a body several times that gets finer pyramid levels on top,
-sampled as sparsely (``auto_scale``).
+``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that view's
+pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads every
+view where the body is about as large (``auto_scale``).
 """
 
 from __future__ import annotations
@@ -67,9 +68,9 @@ class TrackerSettings:
                             "pixels of each level (0: off)")
     iterations: int = _knob(3, "Gauss-Newton iterations per pyramid level, at most")
     pixel_step: int = _knob(2, "Use every n-th pixel across and down on the finest level")
-    auto_scale: bool = _knob(True, "Fit the settings counted in pixels to the body's size: "
-                             "a body over about 280 pixels tall in the footage is tracked as "
-                             "if the footage were halved once per doubling over "
+    auto_scale: bool = _knob(True, "Fit the settings counted in pixels to the body's size in "
+                             "each view: where it stands over about 280 pixels tall, that "
+                             "view is tracked as if halved once per doubling over "
                              f"{REFERENCE_BODY_PIXELS:g}, with its finer pixels sampled "
                              "sparsely on added pyramid levels (faster, and steadier)")
     key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
@@ -111,12 +112,12 @@ class TrackerSettings:
                 raise ValueError(f"settings.{name} must be a whole number >= 1")
 
 
-def body_octaves(skeleton: Skeleton, pose: BodyPose) -> int:
-    """How many times the body at ``pose`` is twice as tall in the footage as
-    ``REFERENCE_BODY_PIXELS`` (its rest pose's largest extent in its largest view, rounded in
-    octaves; 0 for a body no larger)."""
-    pixels = skeleton.height() * max(v.pose.s for v in pose.views)
-    return max(0, int(np.round(np.log2(pixels / REFERENCE_BODY_PIXELS))))
+def view_octaves(skeleton: Skeleton, pose: BodyPose) -> list[int]:
+    """Per view, how many times the body at ``pose`` is twice as tall there as
+    ``REFERENCE_BODY_PIXELS`` (its rest pose's largest extent, rounded in octaves; 0 for a
+    body no larger)."""
+    return [max(0, int(np.round(np.log2(skeleton.height() * v.pose.s
+                                        / REFERENCE_BODY_PIXELS)))) for v in pose.views]
 
 
 def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
@@ -215,7 +216,8 @@ class Tracker:
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
-        self._octaves = 0  # finer levels added to the settings' for a large body (auto_scale)
+        # per view, finer levels added to the settings' for a large body (auto_scale)
+        self._octaves = [0] * self.seq.n_views
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
         self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
         self.n_dof = len(self._dof_joint)
@@ -232,22 +234,23 @@ class Tracker:
         self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
         self._search = LimbSearch(skeleton, self.settings.limb_search)
 
-    def _foregrounds(self, frame: int, lv: int, key: BodyPose, key_frame: int,
+    def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
-        """Per view, the foreground of ``frame`` on level ``lv`` around the body at ``est``
-        (None when the term is off): (boolean crop, its top-left level pixel, its
-        ``NearestPixel``)."""
+        """Per view, the foreground of ``frame`` around the body at ``est`` on the view's
+        level for tracker level ``level`` (None when the term is off): (boolean crop, its
+        top-left level pixel, its ``NearestPixel``)."""
         s = self.settings
         if s.silhouette <= 0:
             return None
         self._learn_first_backdrops(key, key_frame)
         out = []
-        g = self._grid(lv)
-        margin = self._cap() / 2**lv + 2 * g
         for c in range(self.seq.n_views):
             if self._backdrops[c] is None:
                 out.append(None)
                 continue
+            lv = self._view_level(c, level)
+            g = self._grid(c, lv)
+            margin = self._cap(c) / 2**lv + 2 * g
             shape = self.seq.pyramid(c, frame)[lv].shape
             boxes = raycast.blob_boxes(est.views[c].at_level(lv), self._blobs,
                                        kin.segments)
@@ -272,7 +275,7 @@ class Tracker:
             grey = self.seq.grey(c, key_frame)
             backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
                 self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})],
-                sil.BODY_MARGIN * 2**self._octaves)
+                sil.BODY_MARGIN * 2**self._octaves[c])
             if not backdrop.still:
                 self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
                                   "frame (a moving camera?), so its silhouette is not used")
@@ -293,44 +296,57 @@ class Tracker:
         if self.settings.silhouette <= 0:
             return est
         self._learn_first_backdrops(key, key_frame)
-        lv = self._search_level()
+        lvs = [self._view_level(c, self._search_level()) for c in range(self.seq.n_views)]
         fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
-               for c, b in enumerate(self._backdrops)]
+               for c, (b, lv) in enumerate(zip(self._backdrops, lvs))]
         if all(f is None for f in fgs):
             return est
-        searched, turned = self._search.run(est, [v.at_level(lv) for v in est.views], fgs)
+        searched, turned = self._search.run(
+            est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
         return searched if turned else est
 
     def _scale_to(self, pose: BodyPose) -> None:
-        """Fit the pyramid to the body's size in the footage at ``pose`` (``auto_scale``);
+        """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
         what was built for another size is dropped."""
-        k = body_octaves(self.skeleton, pose) if self.settings.auto_scale else 0
-        if k != self._octaves:
-            self._octaves = k
-            self.seq.set_levels(self.settings.levels + k)
+        ks = (view_octaves(self.skeleton, pose) if self.settings.auto_scale
+              else [0] * self.seq.n_views)
+        if ks != self._octaves:
+            self._octaves = ks
+            self.seq.set_levels([self.settings.levels + k for k in ks])
             self._key_sets.clear()
             self._backdrops, self._fg_cache = None, {}
 
+    def _n_levels(self) -> int:
+        """Tracker levels: the largest view's pyramid levels."""
+        return max(self.seq.levels)
+
+    def _view_level(self, view: int, level: int) -> int:
+        """The pyramid level of ``view`` that tracker level ``level`` reads: the one where the
+        body is as large as on the largest view's ``level`` (a view with fewer octaves has
+        fewer finer levels, and reads its full resolution on the finer tracker levels)."""
+        return max(level - (max(self._octaves) - self._octaves[view]), 0)
+
     def _search_level(self) -> int:
-        """The level the limbs are searched on, after the coarser ones placed the body."""
-        return min(1 + self._octaves, self.seq.levels - 1)
+        """The tracker level the limbs are searched on, after the coarser ones placed the
+        body."""
+        return min(1 + max(self._octaves), self._n_levels() - 1)
 
-    def _grid(self, lv: int) -> int:
-        """Level pixels between samples of a level's point sets and label maps: every
-        ``pixel_step``-th on the finest of the settings' levels, and as many full-resolution
-        pixels apart on the finer levels a large body adds."""
-        return self.settings.pixel_step * 2 ** (self._octaves - lv) if lv <= self._octaves \
-            else 1
+    def _grid(self, view: int, lv: int) -> int:
+        """Level pixels between samples of ``view``'s point sets and label maps on its level
+        ``lv``: every ``pixel_step``-th on the finest of the settings' levels, and as many
+        full-resolution pixels apart on the finer levels a large body adds."""
+        k = self._octaves[view]
+        return self.settings.pixel_step * 2 ** (k - lv) if lv <= k else 1
 
-    def _cap(self) -> float:
-        """``silhouette_cap`` in full-resolution pixels of this footage."""
-        return self.settings.silhouette_cap * 2**self._octaves
+    def _cap(self, view: int) -> float:
+        """``silhouette_cap`` in full-resolution pixels of ``view``."""
+        return self.settings.silhouette_cap * 2**self._octaves[view]
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
         (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
         an error the backdrop's margin (as many times wider) covers."""
-        g = 2**self._octaves
+        g = 2**self._octaves[view]
         covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 
@@ -345,11 +361,11 @@ class Tracker:
                 grey = self.seq.grey(c, res.frame)
                 backdrop.learn(grey, self._body_mask(res.pose, kin, c, grey.shape))
 
-    def _active(self, pose: BodyPose, lv: int) -> np.ndarray:
-        """Unknowns solved on level ``lv``: the root always; a joint only where its blob is at
-        least ``min_blob_pixels`` thick in the coarsest-scaled view, so that coarse levels do
-        not fling thin limbs they cannot see."""
-        scale = max(v.pose.s for v in pose.views) / 2**lv
+    def _active(self, pose: BodyPose, level: int) -> np.ndarray:
+        """Unknowns solved on tracker level ``level``: the root always; a joint only where its
+        blob is at least ``min_blob_pixels`` thick in the largest view's level, so that
+        coarse levels do not fling thin limbs they cannot see."""
+        scale = max(v.pose.s for v in pose.views) / 2**level
         nr = self.n_params - self.n_dof
         return np.concatenate([np.ones(nr, bool),
                                self.dof_thickness * scale >= self.settings.min_blob_pixels])
@@ -358,7 +374,7 @@ class Tracker:
     def _point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
                    set_weight: float) -> _PointSet:
         level = self.seq.pyramid(view, frame)[lv]
-        step = self._grid(lv)
+        step = self._grid(view, lv)
         v_l = pose.views[view].at_level(lv)
         pix_l, hits, _ = raycast.render_labels(
             v_l, self._blobs, kin.segments, level.shape, step
@@ -391,35 +407,37 @@ class Tracker:
 
     # --- one level -----------------------------------------------------------------------
     def _sample(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
-                lv: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
+                level: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
                 ) -> _Samples:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
         where the point is hidden by another blob or off the image) and what the rows need.
-        Without ``sigmas`` the points' noise scales are measured here (``_sigmas``): a
-        level's starting pose sets them, and its candidates are costed with them."""
+        ``levels`` holds each view's pyramid level for tracker level ``level``. Without
+        ``sigmas`` the points' noise scales are measured here (``_sigmas``): a level's
+        starting pose sets them, and its candidates are costed with them."""
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
-        g = self._grid(lv)
-        maps = [self._label_map(est, kin, c, levels[c].shape, lv, g)
+        lvs = [self._view_level(c, level) for c in range(self.seq.n_views)]
+        gs = [self._grid(c, lv) for c, lv in enumerate(lvs)]
+        maps = [self._label_map(est, kin, c, levels[c].shape, lvs[c], gs[c])
                 for c in range(self.seq.n_views)]
         labels = [m[0] for m in maps]
         shape_cost, shape_parts = 0.0, []
         if fgs is not None:
-            cap = self._cap() / (2**lv * g)  # in map pixels
-            for (lab, idx, hits), view_fg in zip(maps, fgs):
+            for c, ((lab, idx, hits), view_fg) in enumerate(zip(maps, fgs)):
                 if view_fg is None:
                     shape_parts.append(((), (), (), ()))
                     continue
                 fg, (x0, y0), nearest_fg = view_fg
                 crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
-                mm = sil.mismatch(lab[crop], fg, cap, nearest_fg=nearest_fg)
+                full = 2**lvs[c] * gs[c]  # full-resolution pixels per map pixel
+                mm = sil.mismatch(lab[crop], fg, self._cap(c) / full, nearest_fg=nearest_fg)
                 shape_cost += s.silhouette * mm.cost
                 mm.model += (x0, y0)
                 mm.target += (x0, y0)
                 h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
                 shape_parts.append((self._blobs.joint[hits.label[h]], hits.world[h],
-                                    mm.target * (2**lv * g), mm.weight))
+                                    mm.target * full, mm.weight))
         measured = []
         for k, ps in enumerate(sets):
             view = est.views[ps.view]
@@ -429,7 +447,7 @@ class Tracker:
             if sigmas is None:
                 measured.append(self._sigmas(ps, vals[:, 0] - ps.value, inside))
             sigma = measured[-1] if sigmas is None else sigmas[k]
-            p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / g).astype(int)
+            p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / gs[ps.view]).astype(int)
             lab = labels[ps.view]
             H, W = lab.shape
             inb = (p_l[:, 0] >= 0) & (p_l[:, 0] < W) & (p_l[:, 1] >= 0) & (p_l[:, 1] < H)
@@ -453,7 +471,7 @@ class Tracker:
         return ps.weight[ok] * support_weights(r, sigma[ok], self.settings.outlier_density)
 
     def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
-                          sigmas: list[np.ndarray], lv: int) -> NormalEquations:
+                          sigmas: list[np.ndarray], level: int) -> NormalEquations:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
         and the silhouette's rows (each mismatched pixel's two coordinates); one block of
         rows per view."""
@@ -463,10 +481,11 @@ class Tracker:
                 pieces[ps.view].append((ps.seg_joint[ok], q, grad, r,
                                         self._pixel_weights(ps, ok, r, sigma)))
         s = self.settings
-        g = 2**lv * self._grid(lv)  # full-resolution pixels per map pixel
         for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
             if not len(joints):
                 continue
+            lv = self._view_level(c, level)
+            g = 2**lv * self._grid(c, lv)  # full-resolution pixels per map pixel
             every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
             joints, world, target = joints[::every], world[::every], target[::every]
             pair_w = pair_w[::every]
@@ -564,10 +583,11 @@ class Tracker:
         total_iters = 0
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
-        for lv in reversed(range(self.seq.levels)):
-            levels = [self.seq.pyramid(c, frame)[lv] for c in range(self.seq.n_views)]
+        for level in reversed(range(self._n_levels())):
+            lvs = [self._view_level(c, level) for c in range(self.seq.n_views)]
+            levels = [self.seq.pyramid(c, frame)[lv] for c, lv in enumerate(lvs)]
             sets = []  # per view, the previous frame's points then the key frame's
-            for c in range(self.seq.n_views):
+            for c, lv in enumerate(lvs):
                 view_sets = [self._point_set(prev, kin_prev, c, prev_frame, lv, 1.0)]
                 if s.key_weight > 0 and key_frame != prev_frame:
                     k = (key_frame, c, lv)
@@ -577,20 +597,20 @@ class Tracker:
                     view_sets.append(self._key_sets[k])
                 sets.append(_PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
-            if s.limb_search > 0 and lv == self._search_level():
+            if s.limb_search > 0 and level == self._search_level():
                 searched = self._search_limbs(est, frame, key, key_frame)
                 if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)
-            active = self._active(est, lv)
-            fgs = self._foregrounds(frame, lv, key, key_frame, est, kin)
-            smp = self._sample(est, kin, sets, levels, lv, None, fgs)
+            active = self._active(est, level)
+            fgs = self._foregrounds(frame, level, key, key_frame, est, kin)
+            smp = self._sample(est, kin, sets, levels, level, None, fgs)
             sigmas = smp.sigmas
             left = self._left_views(smp)
             if left:
                 return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
                                    time.perf_counter() - t0)
-            ne = self._normal_equations(kin, sets, smp, sigmas, lv)
+            ne = self._normal_equations(kin, sets, smp, sigmas, level)
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
             converged = False
@@ -600,7 +620,7 @@ class Tracker:
                                                                     active)))
                 cand = apply_update(self.skeleton, est, delta, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
-                c_smp = self._sample(cand, kin_c, sets, levels, lv, sigmas, fgs)
+                c_smp = self._sample(cand, kin_c, sets, levels, level, sigmas, fgs)
                 # compare on the pixels seen in both poses: a step must not win by hiding pixels
                 both = ~np.isnan(smp.costs) & ~np.isnan(c_smp.costs)
                 old = float(np.sum(smp.costs[both]) + smp.shape_cost + prior @ offset**2)
@@ -612,11 +632,11 @@ class Tracker:
                     est, kin, smp = cand, kin_c, c_smp
                     offset = offset + delta
                     lam = max(lam / 3, 1e-6)
-                    if moved / 2**lv < s.converge_pixels:
+                    if moved / 2**level < s.converge_pixels:
                         converged = True
                         break
                     if it + 1 < s.iterations:
-                        ne = self._normal_equations(kin, sets, smp, sigmas, lv)
+                        ne = self._normal_equations(kin, sets, smp, sigmas, level)
                 else:
                     lam *= 4
                     if lam > 1e4:

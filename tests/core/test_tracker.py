@@ -13,9 +13,9 @@ from core.tracker import (
     Tracker,
     TrackerSettings,
     _PointSet,
-    body_octaves,
     depth_blind_joints,
     track,
+    view_octaves,
 )
 from support.synthetic import render, side_view
 
@@ -96,15 +96,17 @@ def _enlarged(pose: BodyPose, factor: float) -> BodyPose:
         for v in pose.views])
 
 
-def test_the_body_octaves_count_doublings_of_its_height_in_the_footage(body):
+def test_each_views_octaves_count_doublings_of_the_bodys_height_there(body):
     sk, pose = body
-    px = sk.height() * max(v.pose.s for v in pose.views)
+    px = sk.height() * pose.views[0].pose.s
+    assert all(v.pose.s == pose.views[0].pose.s for v in pose.views)
     for times, octaves in [(0.4, 0), (1.3, 0), (1.5, 1), (2.0, 1), (2.7, 1), (3.0, 2),
                            (4.0, 2), (8.0, 3)]:
-        assert body_octaves(sk, _enlarged(pose, times * REFERENCE_BODY_PIXELS / px)) == octaves
-    small, large = _enlarged(pose, 1.0), _enlarged(pose, 1.0)
-    large.views[1] = _enlarged(pose, 4 * REFERENCE_BODY_PIXELS / px).views[1]
-    assert body_octaves(sk, small) == 0 and body_octaves(sk, large) == 2  # the largest view
+        enlarged = _enlarged(pose, times * REFERENCE_BODY_PIXELS / px)
+        assert view_octaves(sk, enlarged) == [octaves] * 3
+    mixed = _enlarged(pose, REFERENCE_BODY_PIXELS / px)
+    mixed.views[1] = _enlarged(pose, 4 * REFERENCE_BODY_PIXELS / px).views[1]
+    assert view_octaves(sk, mixed) == [0, 2, 0]
 
 
 def test_a_body_twice_as_large_is_sampled_and_tracked_as_at_its_own_size(body):
@@ -115,7 +117,7 @@ def test_a_body_twice_as_large_is_sampled_and_tracked_as_at_its_own_size(body):
     pose = BodyPose(pose.rotations, pose.root_position, pose.views[:2])
     moved = apply_update(sk, pose, _small_motion(sk, CALIBRATED, 2, seed=4), CALIBRATED)
     big, moved_big = _enlarged(pose, 2.0), _enlarged(moved, 2.0)
-    assert body_octaves(sk, pose) == 0 and body_octaves(sk, big) == 1
+    assert view_octaves(sk, pose) == [0, 0] and view_octaves(sk, big) == [1, 1]
     frames = [[render(sk, big, c, shape=(720, 640)),
                render(sk, moved_big, c, shape=(720, 640), noise=0.01, seed=c)]
               for c in range(2)]
@@ -132,13 +134,53 @@ def test_a_body_twice_as_large_is_sampled_and_tracked_as_at_its_own_size(body):
         assert points(scaled, big, lv + 1) == pytest.approx(points(small, pose, lv), rel=0.05)
     assert points(scaled, big, 0) == pytest.approx(points(small, pose, 0), rel=0.05)
     assert points(fixed, big, 0) > 3.5 * points(small, pose, 0)
-    assert scaled.seq.levels == 4 and fixed.seq.levels == 3
+    assert scaled.seq.levels == [4, 4] and fixed.seq.levels == [3, 3]
 
     res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10)), big, [0, 1])
     after = _limb_errors(sk, res.frames[1].pose, moved_big)
     assert _limb_errors(sk, big, moved_big).max() > 2.0  # the motion is real
     assert after.max() < 0.5, after
     assert np.linalg.norm(res.frames[1].pose.root_position - moved.root_position) < 2e-3
+
+
+def test_views_of_different_sizes_each_read_the_level_where_the_body_is_as_large(body):
+    """One view at the original size, one twice as large: on every tracker level each view
+    is sampled exactly as in footage where both views have its size (the small view's levels
+    one tracker level up, its full resolution again on the level the large one adds), and
+    the known small motion is recovered."""
+    sk, pose = body
+    pose = BodyPose(pose.rotations, pose.root_position, pose.views[:2])
+    moved = apply_update(sk, pose, _small_motion(sk, CALIBRATED, 2, seed=4), CALIBRATED)
+
+    def mixed(p):
+        return BodyPose(p.rotations, p.root_position, [p.views[0], _enlarged(p, 2.0).views[1]])
+
+    big = _enlarged(pose, 2.0)
+    shapes = [(360, 320), (720, 640)]
+    frames = [[render(sk, mixed(p), c, shape=shapes[c], noise=0.01 * i, seed=c)
+               for i, p in enumerate((pose, moved))] for c in range(2)]
+    tracker = Tracker(sk, frames, CALIBRATED)
+    small = Tracker(sk, [[render(sk, pose, c)] for c in range(2)], CALIBRATED)
+    large = Tracker(sk, [[render(sk, big, c, shape=shapes[1])] for c in range(2)], CALIBRATED)
+    for t, p in ((tracker, mixed(pose)), (small, pose), (large, big)):
+        t._scale_to(p)
+    assert tracker.seq.levels == [3, 4]
+    assert [tracker._view_level(0, lv) for lv in range(4)] == [0, 0, 1, 2]
+    assert [tracker._view_level(1, lv) for lv in range(4)] == [0, 1, 2, 3]
+    assert tracker._search_level() == large._search_level() == 2
+
+    def points(t, p, view, lv):
+        return len(t._point_set(p, Kinematics(sk, p), view, 0, lv, 1.0).value)
+
+    for lv in range(4):
+        own = tracker._view_level(0, lv)
+        assert points(tracker, mixed(pose), 0, own) == points(small, pose, 0, own)
+        assert points(tracker, mixed(pose), 1, lv) == points(large, big, 1, lv)
+
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10)), mixed(pose),
+                [0, 1])
+    assert _limb_errors(sk, pose, moved).max() > 2.0  # the motion is real
+    assert _limb_errors(sk, res.frames[1].pose, moved).max() < 0.5
 
 
 def test_constant_velocity_prediction_continues_a_steady_motion(body):
