@@ -87,6 +87,15 @@ def skeleton_from_armature(arm) -> Skeleton:
     return sk
 
 
+def tracked_skeleton(arm) -> Skeleton:
+    """``skeleton_from_armature``, refused when no bone is free to turn (nothing to track)."""
+    sk = skeleton_from_armature(arm)
+    if not sk.dof_names():
+        raise BridgeError(f"no bone of '{arm.name}' is free to turn: unlock the rotations "
+                          "of the bones to track")
+    return sk
+
+
 def _basis_rotation(pb) -> np.ndarray:
     """A pose bone's rotation in its own axes, whatever its rotation mode."""
     if pb.rotation_mode == "QUATERNION":

@@ -1,8 +1,10 @@
 """Tracked poses as keyframes on the armature, and their removal.
 
 Tracking writes keyframes of type GENERATED, so that clearing a track removes exactly what
-tracking wrote and never a key the user set. A ball joint is keyed as a quaternion, a hinge as
-the one Euler channel of its free axis, the root bone as location and quaternion.
+tracking wrote and never a key the user set; where the user keyed a bone on a tracked frame,
+tracking leaves that bone's keys there alone (the frame is the user's correction, see
+``user_keys``). A ball joint is keyed as a quaternion, a hinge as the one Euler channel of its
+free axis, the root bone as location and quaternion.
 """
 
 from __future__ import annotations
@@ -11,9 +13,10 @@ import numpy as np
 from mathutils import Matrix
 
 from ..core.skeleton import BALL, FIXED, HINGE, Skeleton
-from .bridge import armature_rotations
+from .bridge import armature_rotations, pose_from_armature
 
 TRACKED = "GENERATED"  # keyframe type of tracked keys
+USER = "KEYFRAME"  # keyframe type of a correction (Blender keeps a key's type when re-keyed)
 
 
 def channels(arm, sk: Skeleton) -> list[tuple[str, str, int]]:
@@ -32,11 +35,13 @@ def channels(arm, sk: Skeleton) -> list[tuple[str, str, int]]:
     return out
 
 
-def write_pose(arm, sk: Skeleton, frame: int, R: np.ndarray, root: np.ndarray) -> None:
-    """Key the core pose (local rotations R (J, 3, 3), root position (3,)) on ``frame``."""
+def write_pose(arm, sk: Skeleton, frame: int, R: np.ndarray, root: np.ndarray,
+               keep: frozenset[str] = frozenset()) -> None:
+    """Key the core pose (local rotations R (J, 3, 3), root position (3,)) on ``frame``,
+    except on the bones named in ``keep``."""
     Q, loc = armature_rotations(arm, sk, R, root)
     for j, (name, kind) in enumerate(zip(sk.names, sk.kinds)):
-        if kind == FIXED and j:
+        if (kind == FIXED and j) or name in keep:
             continue
         pb = arm.pose.bones[name]
         if j == 0 or kind == BALL:
@@ -74,6 +79,34 @@ def tracked_fcurves(arm, sk: Skeleton, bag) -> list:
     """The F-curves of ``bag`` on the channels tracking keys (see ``channels``)."""
     wanted = {(path, i) for _, path, i in channels(arm, sk)}
     return [fc for fc in bag.fcurves if (fc.data_path, fc.array_index) in wanted]
+
+
+def key_correction(arm, sk: Skeleton, frame: int) -> None:
+    """Key the armature's current pose on ``frame`` as the user's own keys (type KEYFRAME) on
+    every tracked channel, also where tracking had keyed that frame: re-keying a key keeps
+    its type, so a tracked frame re-posed and keyed would still read as tracking's."""
+    R, root = pose_from_armature(arm, sk)
+    write_pose(arm, sk, frame, R, root)
+    for fc in tracked_fcurves(arm, sk, channelbag(arm)):
+        for kp in fc.keyframe_points:
+            if int(round(kp.co[0])) == frame:
+                kp.type = USER
+
+
+def user_keys(arm, sk: Skeleton) -> dict[int, frozenset[str]]:
+    """Per frame, the bones whose tracked channels hold a key the user set (any type but
+    GENERATED) there."""
+    bag = channelbag(arm)
+    if bag is None:
+        return {}
+    bone_of = {(path, i): bone for bone, path, i in channels(arm, sk)}
+    out: dict[int, set[str]] = {}
+    for fc in tracked_fcurves(arm, sk, bag):
+        for kp in fc.keyframe_points:
+            if kp.type != TRACKED:
+                out.setdefault(int(round(kp.co[0])), set()).add(
+                    bone_of[fc.data_path, fc.array_index])
+    return {f: frozenset(bones) for f, bones in out.items()}
 
 
 def clear(arm, sk: Skeleton, frames: set[int] | None = None) -> int:

@@ -13,8 +13,8 @@ from pathlib import Path
 import bpy
 
 from ..core.video import is_video
-from .bridge import armature_from_skeleton, skeleton_from_armature
-from .keyframes import clear
+from .bridge import armature_from_skeleton, skeleton_from_armature, tracked_skeleton
+from .keyframes import clear, key_correction
 from .properties import first_frame_property
 from .reporting import EXPECTED, ArmatureAction
 from .track import TrackSession
@@ -26,13 +26,18 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
     msg = f"tracked {len(done)} of {len(session.frames) - 1} frames"
     if cancelled:
         msg += " (cancelled; the tracked frames are kept)"
+    kept = [session.frames[i] for i in session.corrections
+            if any(r.frame == i for r in session.tracked)]
+    if kept:
+        msg += f"; frame{'s' * (len(kept) > 1)} {', '.join(map(str, kept))} held at the pose " \
+               "you keyed"
     notes = session.tracker.notes
     if notes:
         msg += "; " + "; ".join(notes)
     if diverged:
         last = session.tracked[-1]
-        msg += f"; stopped at frame {diverged[0]}: {last.reason}. Correct the pose there " \
-               "and track again from it"
+        msg += f"; stopped at frame {diverged[0]}: {last.reason}. Pose the armature there, " \
+               "Key Correction, and track again"
         return {"WARNING"}, msg
     return ({"WARNING"} if notes else {"INFO"}), msg
 
@@ -112,6 +117,19 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
         wm.progress_end()
         context.workspace.status_text_set(None)
         return self._finish(context, cancelled)
+
+
+class TWIST_OT_key_correction(ArmatureAction, bpy.types.Operator):
+    """Key the armature's pose on this frame as a correction: Track holds the frame at this
+    pose and holds the frames after it against it"""
+
+    bl_idname = "twist.key_correction"
+    bl_label = "Key Correction"
+
+    def run(self, context) -> str:
+        arm, frame = context.scene.twist.armature, context.scene.frame_current
+        key_correction(arm, tracked_skeleton(arm), frame)
+        return f"keyed the pose of '{arm.name}' on frame {frame} as a correction; track again"
 
 
 class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
@@ -243,5 +261,6 @@ class TWIST_OT_remove_view(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (TWIST_OT_track, TWIST_OT_clear_track, TWIST_OT_add_template_armature,
+CLASSES = (TWIST_OT_track, TWIST_OT_key_correction, TWIST_OT_clear_track,
+           TWIST_OT_add_template_armature,
            TWIST_OT_add_view, TWIST_OT_remove_view)

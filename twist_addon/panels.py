@@ -89,7 +89,9 @@ class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
         row = layout.row(align=True)
         row.scale_y = 1.4
         row.operator("twist.track", icon="TRACKING")
-        layout.operator("twist.clear_track", icon="X")
+        row = layout.row(align=True)
+        row.operator("twist.key_correction", icon="KEY_HLT")
+        row.operator("twist.clear_track", icon="X")
         layout.operator("twist.refine_skeleton", icon="BONE_DATA")
 
 

@@ -14,7 +14,7 @@ from ..core.pose import BodyPose
 from ..core.tracker import FrameResult, Tracker
 from ..core.video import VideoFrames, is_video
 from . import keyframes
-from .bridge import BridgeError, pose_from_armature, skeleton_from_armature, view_from_camera
+from .bridge import BridgeError, pose_from_armature, tracked_skeleton, view_from_camera
 from .properties import settings_from_properties
 
 
@@ -44,12 +44,17 @@ def footage_frames(view_pg, frames: list[int]) -> list:
 
 @dataclass
 class TrackSession:
-    """Everything one run needs, checked before the first frame is tracked."""
+    """Everything one run needs, checked before the first frame is tracked. A frame after the
+    first where the user keyed a tracked bone is a correction: its pose (as the scene shows
+    it there) is taken as that frame's result and becomes the key frame later frames are held
+    against, and the user's keys stay as they are."""
 
     armature: bpy.types.Object
     frames: list[int]
     tracker: Tracker
     initial: BodyPose
+    user_keys: dict[int, frozenset[str]] = field(default_factory=dict)  # frame -> bones
+    corrections: dict[int, BodyPose] = field(default_factory=dict)  # by index in ``frames``
     tracked: list[FrameResult] = field(default_factory=list)
 
     @classmethod
@@ -73,25 +78,32 @@ class TrackSession:
                 raise BridgeError("a view has no camera; pick its camera or remove the view")
             views.append(view_from_camera(v.camera, scene))
             images.append(footage_frames(v, frames))
-        sk = skeleton_from_armature(arm)
-        if not sk.dof_names():
-            raise BridgeError(f"no bone of '{arm.name}' is free to turn: unlock the rotations "
-                              "of the bones to track")
+        sk = tracked_skeleton(arm)
         R, root = pose_from_armature(arm, sk)
+        user_keys = keyframes.user_keys(arm, sk)
+        corrections = {}
+        for i, f in enumerate(frames[1:], 1):
+            if f in user_keys:
+                scene.frame_set(f)
+                corrections[i] = BodyPose(*pose_from_armature(arm, sk), views)
+        if corrections:
+            scene.frame_set(cur)
         settings = settings_from_properties(tw.tracker)
         # the tracker indexes frames 0..n-1 in tracking order
         tracker = Tracker(sk, images, tw.mode.lower(), settings)
-        return cls(arm, frames, tracker, BodyPose(R, root, views))
+        return cls(arm, frames, tracker, BodyPose(R, root, views), user_keys, corrections)
 
     def run(self):
         """Yield after each frame is tracked and keyed."""
         sk = self.tracker.skeleton
-        steps = self.tracker.iter_track(self.initial, range(len(self.frames)))
+        steps = self.tracker.iter_track(self.initial, range(len(self.frames)),
+                                        self.corrections)
         for res in steps:
             frame = self.frames[res.frame]
             if res.frame and not res.diverged:
                 R = res.pose.rotations.copy()
                 R[0], root = world_root(self.tracker.mode, self.initial.views[0], res.pose)
-                keyframes.write_pose(self.armature, sk, frame, R, root)
+                keyframes.write_pose(self.armature, sk, frame, R, root,
+                                     self.user_keys.get(frame, frozenset()))
             self.tracked.append(res)
             yield res

@@ -102,6 +102,49 @@ def test_one_view_tracks_and_notes_the_joints_it_cannot_see_turn_in_depth(bpy_mo
     assert " ".join(lines) == notes[0]  # wrapped into the sidebar's lines, nothing lost
 
 
+def _quaternions(addon, arm, bones, frame):
+    """Each bone's quaternion keyed on ``frame``, and the types of those keys."""
+    bag = addon.twist_addon.keyframes.channelbag(arm)
+    out = {}
+    for bone in bones:
+        path = f'pose.bones["{bone}"].rotation_quaternion'
+        keys = [next(k for k in bag.fcurves.find(path, index=i).keyframe_points
+                     if int(k.co[0]) == frame) for i in range(4)]
+        out[bone] = (np.array([k.co[1] for k in keys]), {k.type for k in keys})
+    return out
+
+
+def test_a_keyed_correction_holds_its_frame_and_stays_the_users(bpy_module, registered,
+                                                               footage):
+    """Track with one iteration a level, re-pose the left knee on frame 4 and Key Correction,
+    track again with three: frame 4 keeps the keyed pose (the knee as the user set it, the
+    other bones as the scene showed them, not tracked again) in keys of the user's type,
+    which Clear Track keeps; the frames around it are tracked anew."""
+    from mathutils import Quaternion
+
+    bpy = bpy_module
+    scene, arm = _scene(bpy, registered, footage)
+    scene.twist.tracker.iterations = 1
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    first = {f: _quaternions(registered, arm, ["LeftKnee", "RightHip"], f) for f in (3, 4)}
+    scene.frame_set(4)
+    knee = arm.pose.bones["LeftKnee"]
+    knee.rotation_quaternion = knee.rotation_quaternion @ Quaternion((1, 0, 0), 0.4)
+    keyed = np.array(knee.rotation_quaternion)
+    assert bpy.ops.twist.key_correction() == {"FINISHED"}
+    scene.twist.tracker.iterations = 3
+    scene.frame_set(1)
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    again = {f: _quaternions(registered, arm, ["LeftKnee", "RightHip"], f) for f in (3, 4, 5)}
+    assert np.allclose(again[4]["LeftKnee"][0], keyed, atol=1e-6)
+    assert np.allclose(again[4]["RightHip"][0], first[4]["RightHip"][0], atol=1e-6)
+    assert again[4]["LeftKnee"][1] == again[4]["RightHip"][1] == {"KEYFRAME"}
+    assert np.abs(again[3]["RightHip"][0] - first[3]["RightHip"][0]).max() > 1e-4  # re-tracked
+    assert again[3]["RightHip"][1] == again[5]["RightHip"][1] == {"GENERATED"}
+    assert bpy.ops.twist.clear_track() == {"FINISHED"}
+    assert _channel_frames(arm)["LeftKnee"] == {(4, "KEYFRAME")}
+
+
 def _bvh_world(bvh, R, p):
     from core.skeleton import skeleton_from_bvh
 
