@@ -11,6 +11,7 @@ never removed or changed in meaning. Relative paths are relative to the job file
                                           "limits": [0, 150]}},
                   "blobs": {"Chest": {"radius": 0.12}, "LeftCollar": false}},
      "initial": {"bvh": "body.bvh", "frame": 0},
+     "corrections": [{"image": 30, "bvh": "fixed.bvh", "frame": 0}],
      "views": [{"images": "lateral/*.png",
                 "camera": {"model": "scaled_orthographic", "R": [[1,0,0],[0,1,0],[0,0,1]],
                            "t": [0, 0, 0], "scale": 100, "center": [240, 180]}}],
@@ -25,6 +26,9 @@ optional ``limits`` bound its angle in degrees (the rotation vector's component 
 axis, 0 at the BVH's rest pose), so that the tracker never bends it backwards. A blob entry
 sets the short radius (``radius``, or two ``radii``) and optionally the full ``length`` along
 the bone (centred on the bone) of every blob of that joint, or is ``false`` to drop them.
+Optional ``corrections`` give the pose at later frames (``image``: the index of the footage
+frame, 1 or more; the pose as a frame of a BVH with the skeleton's hierarchy): such a frame
+is not tracked but takes that pose, and the frames after it are held against it.
 """
 
 from __future__ import annotations
@@ -61,6 +65,7 @@ class Job:
     mode: str
     settings: TrackerSettings
     frame_time: float
+    corrections: dict[int, BodyPose] = dataclasses.field(default_factory=dict)  # by image
 
 
 def _field(d: dict, key: str, where: str, kind=None):
@@ -225,8 +230,9 @@ def _read_json(path: Path, what: str) -> dict:
     return d
 
 
-def _body(d: dict, base: Path, where: str) -> tuple[Skeleton, BvhFile, BvhFile, int]:
-    """The ``skeleton`` and ``initial`` fields: skeleton, its BVH, the initial BVH and frame."""
+def _body(d: dict, base: Path, where: str) -> tuple[Skeleton, BvhFile, Path, BvhFile, int]:
+    """The ``skeleton`` and ``initial`` fields: skeleton, its BVH and that file's path, the
+    initial BVH and frame."""
     sk_spec = _field(d, "skeleton", where, dict)
     bvh_path = base / _field(sk_spec, "bvh", f"{where}.skeleton", str)
     try:
@@ -238,20 +244,47 @@ def _body(d: dict, base: Path, where: str) -> tuple[Skeleton, BvhFile, BvhFile, 
     sk.blobs = sk.default_blobs()
     if "blobs" in sk_spec:
         _apply_blobs(sk, sk_spec["blobs"], f"{where}.skeleton.blobs")
-    init = _field(d, "initial", where, dict)
-    init_path = base / _field(init, "bvh", f"{where}.initial", str)
-    frame = _field(init, "frame", f"{where}.initial", int) if "frame" in init else 0
+    init_bvh, frame = _bvh_pose(_field(d, "initial", where, dict), bvh, bvh_path, base,
+                                f"{where}.initial")
+    return sk, bvh, bvh_path, init_bvh, frame
+
+
+def _bvh_pose(spec: dict, bvh: BvhFile, bvh_path: Path, base: Path, where: str
+              ) -> tuple[BvhFile, int]:
+    """A pose given as ``{"bvh": path, "frame": k}`` (frame 0 if not given): the BVH holding
+    it (``bvh`` itself when the path is ``bvh_path``) and the frame, checked."""
+    path = base / _field(spec, "bvh", where, str)
+    frame = _field(spec, "frame", where, int) if "frame" in spec else 0
     try:
-        init_bvh = bvh if init_path == bvh_path else read_bvh(init_path)
+        pose_bvh = bvh if path == bvh_path else read_bvh(path)
     except BvhError as e:
-        raise JobError(f"{where}.initial.bvh: {e}") from None
-    if init_bvh.names != bvh.names:
-        raise JobError(f"{where}.initial.bvh: its hierarchy differs from the skeleton's BVH")
-    if not 0 <= frame < len(init_bvh.motion):
-        raise JobError(
-            f"{where}.initial.frame: {frame} is outside 0..{len(init_bvh.motion) - 1}"
-        )
-    return sk, bvh, init_bvh, frame
+        raise JobError(f"{where}.bvh: {e}") from None
+    if pose_bvh.names != bvh.names:
+        raise JobError(f"{where}.bvh: its hierarchy differs from the skeleton's BVH")
+    if not 0 <= frame < len(pose_bvh.motion):
+        raise JobError(f"{where}.frame: {frame} is outside 0..{len(pose_bvh.motion) - 1}")
+    return pose_bvh, frame
+
+
+def _corrections(spec, sk: Skeleton, bvh: BvhFile, bvh_path: Path, base: Path,
+                 cameras: list[View], n_frames: int, where: str) -> dict[int, BodyPose]:
+    """The ``corrections`` field: footage frame -> the pose the user gives there."""
+    if not isinstance(spec, list):
+        raise JobError(f"{where}: expected a list of {{image, bvh, frame}}")
+    out = {}
+    for i, c in enumerate(spec):
+        at = f"{where}[{i}]"
+        if not isinstance(c, dict):
+            raise JobError(f"{at}: expected an object with image, bvh and frame")
+        image = _field(c, "image", at, int)
+        if not 1 <= image < n_frames:
+            raise JobError(f"{at}.image: {image} is outside 1..{n_frames - 1} (frame 0 is "
+                           "the initial pose's)")
+        if image in out:
+            raise JobError(f"{at}.image: frame {image} is corrected twice")
+        pose_bvh, frame = _bvh_pose(c, bvh, bvh_path, base, at)
+        out[image] = initial_pose(sk, pose_bvh, frame, cameras)
+    return out
 
 
 def _views(d: dict, where: str) -> tuple[list[dict], list[View]]:
@@ -276,7 +309,7 @@ def load_job(path: str | Path) -> Job:
     path = Path(path)
     d = _read_json(path, "job file")
     base, where = path.parent, path.name
-    sk, bvh, init_bvh, frame = _body(d, base, where)
+    sk, bvh, bvh_path, init_bvh, frame = _body(d, base, where)
     views, cameras = _views(d, where)
     images = [_images(_field(v, "images", f"{where}.views[{i}]"), base,
                       f"{where}.views[{i}].images") for i, v in enumerate(views)]
@@ -292,7 +325,9 @@ def load_job(path: str | Path) -> Job:
     if not isinstance(ft, (int, float)) or ft <= 0:
         raise JobError(f"{where}.frame_time: expected seconds per frame > 0, got {ft!r}")
     pose = initial_pose(sk, init_bvh, frame, cameras)
-    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft))
+    corrections = _corrections(d.get("corrections", []), sk, bvh, bvh_path, base, cameras,
+                               len(images[0]), f"{where}.corrections")
+    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections)
 
 
 @dataclass
@@ -316,7 +351,7 @@ def load_fit(path: str | Path) -> FitJob:
     path = Path(path)
     d = _read_json(path, "fit file")
     base, where = path.parent, path.name
-    sk, bvh, init_bvh, frame = _body(d, base, where)
+    sk, bvh, _, init_bvh, frame = _body(d, base, where)
     views, cameras = _views(d, where)
     clicks_in = _field(d, "clicks", where, list)
     if len(clicks_in) != len(views):

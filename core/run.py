@@ -18,10 +18,11 @@ def run_job(
     progress: Callable[[FrameResult, int, int], None] | None = None,
     cancel: Callable[[], bool] | None = None,
 ) -> TrackResult:
-    """Track every frame of the job's footage from its first frame."""
+    """Track every frame of the job's footage from its first frame (a corrected frame takes
+    its given pose)."""
     tracker = Tracker(job.skeleton, job.images, job.mode, job.settings)
     frames = list(range(len(job.images[0])))
-    return track(tracker, job.initial, frames, progress, cancel)
+    return track(tracker, job.initial, frames, progress, cancel, job.corrections)
 
 
 def result_bvh(job: Job, result: TrackResult):

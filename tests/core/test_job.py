@@ -94,6 +94,24 @@ def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path, mode):
     assert {"frame", "residual", "iterations", "converged", "seconds"} <= set(report["frames"][1])
 
 
+def test_a_corrected_frame_takes_its_given_pose_and_the_others_are_tracked(footage, tmp_path):
+    """The job corrects frame 2 to the walk's first pose (as if the user had set it there):
+    the output holds that pose on frame 2 and frame 1 tracked as before."""
+    folder, job = footage
+    job_path = folder / "job_corrected.json"
+    job_path.write_text(json.dumps(dict(job, corrections=[
+        {"image": 2, "bvh": "walk.bvh", "frame": 0}])))
+    assert set(load_job(job_path).corrections) == {2}
+    plain, corrected = tmp_path / "plain.bvh", tmp_path / "corrected.bvh"
+    assert _run("track", folder / "job.json", "--out", plain).returncode == 0
+    proc = _run("track", job_path, "--out", corrected)
+    assert proc.returncode == 0, proc.stderr
+    src = read_bvh(folder / "walk.bvh")
+    np.testing.assert_allclose(read_bvh(corrected).motion[2], src.motion[0], atol=1e-4)
+    assert np.abs(read_bvh(plain).motion[2] - src.motion[0]).max() > 1.0  # it moved
+    np.testing.assert_allclose(read_bvh(corrected).motion[1], read_bvh(plain).motion[1])
+
+
 @pytest.mark.parametrize(
     "change, message",
     [
@@ -117,6 +135,13 @@ def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path, mode):
          "every view needs the same number of frames, got 3, 3, 3, 1"),
         (lambda j: j.update(mode="both"), "job.json.mode: expected 'calibrated' or"),
         (lambda j: j["initial"].update(frame=7), r"initial.frame: 7 is outside 0..2"),
+        (lambda j: j.update(corrections=[{"image": 0, "bvh": "walk.bvh"}]),
+         r"corrections\[0\].image: 0 is outside 1..2 \(frame 0 is the initial pose's\)"),
+        (lambda j: j.update(corrections=[{"image": 2, "bvh": "walk.bvh", "frame": 9}]),
+         r"corrections\[0\].frame: 9 is outside 0..2"),
+        (lambda j: j.update(corrections=[{"image": 1, "bvh": "walk.bvh"}] * 2),
+         r"corrections\[1\].image: frame 1 is corrected twice"),
+        (lambda j: j.update(corrections={"image": 1}), "job.json.corrections: expected a list"),
     ],
 )
 def test_malformed_jobs_get_one_clear_error(footage, tmp_path, change, message):
