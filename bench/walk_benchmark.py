@@ -2,13 +2,16 @@
 command line, scored against the capture.
 
     python bench/walk_benchmark.py [--zoom 1] [--runs NAME,...] [--settings JSON]
+                                   [--correct-every N]
 
 Renders the footage once (bench/walk_footage.py, cached), writes one job per run, runs
 ``python -m core track`` on each, and prints tables of limb-direction error, joint-position
 error, local-rotation error, frames tracked before any divergence and speed, beside two
 references on the same frames: the first frame held still, and the best fit that the tracked
 degrees of freedom allow to the true 3-D joints. Each run tracks the paper's 19 degrees of
-freedom, or ("+ spine") 22 with the lower back a ball too.
+freedom, or ("+ spine") 22 with the lower back a ball too. With --correct-every N, every
+N-th frame is given the capture's pose as a user's correction, and the frames between are
+scored.
 """
 
 from __future__ import annotations
@@ -92,6 +95,8 @@ def main(argv=None) -> int:
     ap.add_argument("--last", type=int, default=772)
     ap.add_argument("--runs", default=",".join(RUNS), help="comma-separated run names")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
+    ap.add_argument("--correct-every", type=int, default=0, metavar="N",
+                    help="correct every N-th frame to the capture's pose, as a user would")
     a = ap.parse_args(argv)
     a.cache = footage_cache(a)
     t0 = time.perf_counter()
@@ -108,7 +113,7 @@ def main(argv=None) -> int:
         views, mode, step, joints = RUNS[name]
         job_path = write_job(a.cache, name.replace(" + ", "_").replace(" ", "_"), views, mode,
                              info["frames"][:: step // 4], info["cameras"], settings,
-                             step / CAPTURE_FPS, joints)
+                             step / CAPTURE_FPS, joints, a.correct_every)
         out = job_path.with_suffix(".bvh")
         rep_path = job_path.with_suffix(".report.json")
         cmd = [sys.executable, "-m", "core", "track", str(job_path), "--out", str(out),
@@ -124,7 +129,10 @@ def main(argv=None) -> int:
         sel = slice(None, None, step // 4)
         truth = (truth_all[0][sel], truth_all[1][sel])
         est = read_bvh(out).poses()
-        results[name] = (evaluate.score(sk, tracked_names, est, truth), rep)
+        # corrected frames are the capture's own: scored are the frames tracked
+        scored = [i for i in range(len(est[0])) if i not in job.corrections]
+        results[name] = (evaluate.score(sk, tracked_names, (est[0][scored], est[1][scored]),
+                                        (truth[0][scored], truth[1][scored])), rep)
         ref_of[name] = step, "best fit + spine" if joints is SPINE_JOINTS else "best fit"
         if ref_of[name] not in refs:
             refs[ref_of[name]] = (

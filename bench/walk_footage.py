@@ -352,11 +352,13 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
 
 
 def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list[int],
-              cameras: dict, settings: dict, frame_time: float, joints: dict = JOINTS
-              ) -> Path:
+              cameras: dict, settings: dict, frame_time: float, joints: dict = JOINTS,
+              correct_every: int = 0) -> Path:
     """Write folder/jobs/<name>.json tracking the given rendered frames (capture indices) of
     the given views with the tracked ``joints``; the skeleton and initial pose come from
-    folder/truth.bvh's first frame, which must be the first of ``frames``."""
+    folder/truth.bvh's first frame, which must be the first of ``frames``. With
+    ``correct_every`` N, every N-th frame is corrected to the capture's pose there, as a
+    user who keyed it would."""
     jobs = folder / "jobs"
     jobs.mkdir(exist_ok=True)
     job = {
@@ -368,6 +370,11 @@ def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list
         "settings": settings,
         "frame_time": frame_time,
     }
+    if correct_every:
+        truth_frames = json.loads((folder / "footage.json").read_text())["frames"]  # truth.bvh
+        job["corrections"] = [{"image": i, "bvh": "../truth.bvh",
+                               "frame": truth_frames.index(frames[i])}
+                              for i in range(correct_every, len(frames), correct_every)]
     path = jobs / f"{name}.json"
     path.write_text(json.dumps(job, indent=1))
     return path

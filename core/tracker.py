@@ -148,6 +148,7 @@ class FrameResult:
     diverged: bool = False
     reason: str = ""
     seconds: float = 0.0
+    given: bool = False  # the user's pose (the initial one or a correction), not tracked
 
 
 @dataclass
@@ -692,7 +693,7 @@ class Tracker:
                 "away from the camera unseen (only foreshortening shows it): add a view from "
                 "another side, or track them as hinges about the line of sight")
         self._scale_to(initial)
-        first = FrameResult(key_frame, initial.copy(), 0.0, 0, True)
+        first = FrameResult(key_frame, initial.copy(), 0.0, 0, True, given=True)
         yield first
         history = [first]
         residuals: list[float] = []
@@ -703,10 +704,12 @@ class Tracker:
             if frame in corrections:
                 key_frame, key = frame, corrections[frame].copy()
                 self._key_sets.clear()
-                res = FrameResult(frame, key.copy(), 0.0, 0, True)
+                res = FrameResult(frame, key.copy(), 0.0, 0, True, given=True)
                 self.seq.keep_only({(c, frame) for c in range(self.seq.n_views)})
                 yield res
-                history = history[-1:] + [res]
+                # the step from a given pose is a velocity; from a tracked one it is mostly
+                # the error the correction takes out, which carried on flung the next frames
+                history = history[-1:] + [res] if prev.given else [res]
                 continue
             pred = (self._predicted(history[-2].pose, prev.pose) if len(history) >= 2
                     else prev.pose.copy())

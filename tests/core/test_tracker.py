@@ -350,6 +350,28 @@ def test_a_note_names_the_joints_that_turn_in_depth_when_the_views_share_a_line_
     assert track(Tracker(sk, three, CALIBRATED), pose, [0, 1]).notes == []
 
 
+def test_a_correction_after_tracked_frames_starts_the_motion_afresh(body):
+    """The body stands still, jumps 20 degrees between frames 1 and 2 and stands still again;
+    frame 2 is corrected to the jump. Frame 3 is found where the body stands: the step from
+    tracked frame 1 to the correction is no velocity (carried on, it left frame 3 13 degrees
+    off); from a given pose before it, it is (frames 0 and 1 both given, the body moving
+    on)."""
+    sk, pose = body
+    jump = apply_update(sk, pose, 4 * _small_motion(sk, CALIBRATED, 3, seed=4), CALIBRATED)
+    assert _limb_errors(sk, pose, jump).max() > 15
+    frames = [[render(sk, p, c, noise=0.01, seed=i) for i, p in enumerate((pose, pose, jump,
+                                                                           jump))]
+              for c in range(3)]
+    res = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1, 2, 3], corrections={2: jump})
+    assert [f.given for f in res.frames] == [True, False, True, False]
+    assert _limb_errors(sk, res.frames[3].pose, jump).max() < 0.5
+    further = apply_update(sk, jump, 4 * _small_motion(sk, CALIBRATED, 3, seed=4), CALIBRATED)
+    moving = [[render(sk, p, c) for p in (pose, jump, further)] for c in range(3)]
+    res = track(Tracker(sk, moving, CALIBRATED), pose, [0, 1, 2], corrections={1: jump})
+    # held still instead, the step of 23 degrees was missed by 51
+    assert _limb_errors(sk, res.frames[2].pose, further).max() < 0.5
+
+
 def test_a_hinge_is_held_within_its_limits(body):
     """The footage bends the left knee 25 degrees; a knee limited to 10 stops there."""
     _, pose = body
