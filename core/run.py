@@ -64,6 +64,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
                 "diverged": f.diverged,
                 "reason": f.reason,
                 "seconds": f.seconds,
+                "given": f.given,
             }
             for f in result.frames
         ],

@@ -104,8 +104,11 @@ def test_a_corrected_frame_takes_its_given_pose_and_the_others_are_tracked(foota
     assert set(load_job(job_path).corrections) == {2}
     plain, corrected = tmp_path / "plain.bvh", tmp_path / "corrected.bvh"
     assert _run("track", folder / "job.json", "--out", plain).returncode == 0
-    proc = _run("track", job_path, "--out", corrected)
+    report = tmp_path / "report.json"
+    proc = _run("track", job_path, "--out", corrected, "--report", report)
     assert proc.returncode == 0, proc.stderr
+    frames = json.loads(report.read_text())["frames"]
+    assert [f["given"] for f in frames] == [True, False, True]
     src = read_bvh(folder / "walk.bvh")
     np.testing.assert_allclose(read_bvh(corrected).motion[2], src.motion[0], atol=1e-4)
     assert np.abs(read_bvh(plain).motion[2] - src.motion[0]).max() > 1.0  # it moved
