@@ -29,8 +29,10 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
     kept = [session.frames[i] for i in session.corrections
             if any(r.frame == i for r in session.tracked)]
     if kept:
-        msg += f"; frame{'s' * (len(kept) > 1)} {', '.join(map(str, kept))} held at the pose " \
-               "you keyed"
+        listed = ", ".join(map(str, kept)) if len(kept) <= 5 else \
+            f"{', '.join(map(str, kept[:3]))} ... {kept[-1]}"
+        msg += f"; {len(kept)} frame{'s' * (len(kept) > 1)} ({listed}) held at the pose you " \
+               "keyed"
     notes = session.tracker.notes
     if notes:
         msg += "; " + "; ".join(notes)
