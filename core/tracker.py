@@ -17,7 +17,7 @@ whose residual jumps, whose body leaves the images or whose system is degenerate
 as diverged instead of being accepted. Sizes in pixels are meant for a body about
 ``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that view's
 pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads every
-view where the body is about as large (``auto_scale``).
+view where the body is about as large (``auto_scale``, ``core.scales``).
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ from . import silhouette as sil
 from .blas import one_blas_thread
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
+from .scales import REFERENCE_BODY_PIXELS, Scales
 from .search import SIDE_ON, LimbSearch
 from .sequence import ImageSequence
 from .skeleton import HINGE, Skeleton
@@ -48,9 +49,6 @@ from .solver import (
 
 SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
 BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
-# the body's height in the footage (pixels) that the pixel-sized settings are meant for: the
-# benchmark's 480x360 views, where they were measured, show it 205 pixels tall
-REFERENCE_BODY_PIXELS = 200.0
 ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
 
 
@@ -110,14 +108,6 @@ class TrackerSettings:
         for name in ("levels", "iterations", "pixel_step"):
             if int(getattr(self, name)) < 1:
                 raise ValueError(f"settings.{name} must be a whole number >= 1")
-
-
-def view_octaves(skeleton: Skeleton, pose: BodyPose) -> list[int]:
-    """Per view, how many times the body at ``pose`` is twice as tall there as
-    ``REFERENCE_BODY_PIXELS`` (its rest pose's largest extent, rounded in octaves; 0 for a
-    body no larger)."""
-    return [max(0, int(np.round(np.log2(skeleton.height() * v.pose.s
-                                        / REFERENCE_BODY_PIXELS)))) for v in pose.views]
 
 
 def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
@@ -217,8 +207,8 @@ class Tracker:
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
-        # per view, finer levels added to the settings' for a large body (auto_scale)
-        self._octaves = [0] * self.seq.n_views
+        self._scales = Scales((0,) * self.seq.n_views, self.settings.levels,
+                              self.settings.pixel_step, self.settings.silhouette_cap)
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
         self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
         self.n_dof = len(self._dof_joint)
@@ -249,9 +239,9 @@ class Tracker:
             if self._backdrops[c] is None:
                 out.append(None)
                 continue
-            lv = self._view_level(c, level)
-            g = self._grid(c, lv)
-            margin = self._cap(c) / 2**lv + 2 * g
+            lv = self._scales.view_level(c, level)
+            g = self._scales.grid(c, lv)
+            margin = self._scales.cap(c) / 2**lv + 2 * g
             shape = self.seq.pyramid(c, frame)[lv].shape
             boxes = raycast.blob_boxes(est.views[c].at_level(lv), self._blobs,
                                        kin.segments)
@@ -276,7 +266,7 @@ class Tracker:
             grey = self.seq.grey(c, key_frame)
             backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
                 self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})],
-                sil.BODY_MARGIN * 2**self._octaves[c])
+                sil.BODY_MARGIN * self._scales.magnification(c))
             if not backdrop.still:
                 self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
                                   "frame (a moving camera?), so its silhouette is not used")
@@ -297,7 +287,8 @@ class Tracker:
         if self.settings.silhouette <= 0:
             return est
         self._learn_first_backdrops(key, key_frame)
-        lvs = [self._view_level(c, self._search_level()) for c in range(self.seq.n_views)]
+        lvs = [self._scales.view_level(c, self._scales.search_level())
+               for c in range(self.seq.n_views)]
         fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
                for c, (b, lv) in enumerate(zip(self._backdrops, lvs))]
         if all(f is None for f in fgs):
@@ -309,45 +300,18 @@ class Tracker:
     def _scale_to(self, pose: BodyPose) -> None:
         """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
         what was built for another size is dropped."""
-        ks = (view_octaves(self.skeleton, pose) if self.settings.auto_scale
-              else [0] * self.seq.n_views)
-        if ks != self._octaves:
-            self._octaves = ks
-            self.seq.set_levels([self.settings.levels + k for k in ks])
+        scales = Scales.of(self.skeleton, pose, self.settings)
+        if scales != self._scales:
+            self._scales = scales
+            self.seq.set_levels(scales.pyramid_levels())
             self._key_sets.clear()
             self._backdrops, self._fg_cache = None, {}
-
-    def _n_levels(self) -> int:
-        """Tracker levels: the largest view's pyramid levels."""
-        return max(self.seq.levels)
-
-    def _view_level(self, view: int, level: int) -> int:
-        """The pyramid level of ``view`` that tracker level ``level`` reads: the one where the
-        body is as large as on the largest view's ``level`` (a view with fewer octaves has
-        fewer finer levels, and reads its full resolution on the finer tracker levels)."""
-        return max(level - (max(self._octaves) - self._octaves[view]), 0)
-
-    def _search_level(self) -> int:
-        """The tracker level the limbs are searched on, after the coarser ones placed the
-        body."""
-        return min(1 + max(self._octaves), self._n_levels() - 1)
-
-    def _grid(self, view: int, lv: int) -> int:
-        """Level pixels between samples of ``view``'s point sets and label maps on its level
-        ``lv``: every ``pixel_step``-th on the finest of the settings' levels, and as many
-        full-resolution pixels apart on the finer levels a large body adds."""
-        k = self._octaves[view]
-        return self.settings.pixel_step * 2 ** (k - lv) if lv <= k else 1
-
-    def _cap(self, view: int) -> float:
-        """``silhouette_cap`` in full-resolution pixels of ``view``."""
-        return self.settings.silhouette_cap * 2**self._octaves[view]
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
         (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
         an error the backdrop's margin (as many times wider) covers."""
-        g = 2**self._octaves[view]
+        g = self._scales.magnification(view)
         covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 
@@ -375,7 +339,7 @@ class Tracker:
     def _point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
                    set_weight: float) -> _PointSet:
         level = self.seq.pyramid(view, frame)[lv]
-        step = self._grid(view, lv)
+        step = self._scales.grid(view, lv)
         v_l = pose.views[view].at_level(lv)
         pix_l, hits, _ = raycast.render_labels(
             v_l, self._blobs, kin.segments, level.shape, step
@@ -418,8 +382,8 @@ class Tracker:
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
-        lvs = [self._view_level(c, level) for c in range(self.seq.n_views)]
-        gs = [self._grid(c, lv) for c, lv in enumerate(lvs)]
+        lvs = [self._scales.view_level(c, level) for c in range(self.seq.n_views)]
+        gs = [self._scales.grid(c, lv) for c, lv in enumerate(lvs)]
         maps = [self._label_map(est, kin, c, levels[c].shape, lvs[c], gs[c])
                 for c in range(self.seq.n_views)]
         labels = [m[0] for m in maps]
@@ -432,7 +396,8 @@ class Tracker:
                 fg, (x0, y0), nearest_fg = view_fg
                 crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
                 full = 2**lvs[c] * gs[c]  # full-resolution pixels per map pixel
-                mm = sil.mismatch(lab[crop], fg, self._cap(c) / full, nearest_fg=nearest_fg)
+                mm = sil.mismatch(lab[crop], fg, self._scales.cap(c) / full,
+                                  nearest_fg=nearest_fg)
                 shape_cost += s.silhouette * mm.cost
                 mm.model += (x0, y0)
                 mm.target += (x0, y0)
@@ -485,8 +450,8 @@ class Tracker:
         for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
             if not len(joints):
                 continue
-            lv = self._view_level(c, level)
-            g = 2**lv * self._grid(c, lv)  # full-resolution pixels per map pixel
+            lv = self._scales.view_level(c, level)
+            g = 2**lv * self._scales.grid(c, lv)  # full-resolution pixels per map pixel
             every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
             joints, world, target = joints[::every], world[::every], target[::every]
             pair_w = pair_w[::every]
@@ -584,8 +549,8 @@ class Tracker:
         total_iters = 0
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
-        for level in reversed(range(self._n_levels())):
-            lvs = [self._view_level(c, level) for c in range(self.seq.n_views)]
+        for level in reversed(range(self._scales.n_levels())):
+            lvs = [self._scales.view_level(c, level) for c in range(self.seq.n_views)]
             levels = [self.seq.pyramid(c, frame)[lv] for c, lv in enumerate(lvs)]
             sets = []  # per view, the previous frame's points then the key frame's
             for c, lv in enumerate(lvs):
@@ -598,7 +563,7 @@ class Tracker:
                     view_sets.append(self._key_sets[k])
                 sets.append(_PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
-            if s.limb_search > 0 and level == self._search_level():
+            if s.limb_search > 0 and level == self._scales.search_level():
                 searched = self._search_limbs(est, frame, key, key_frame)
                 if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)

@@ -7,15 +7,14 @@ from core import se3
 from core.camera import View
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
+from core.scales import REFERENCE_BODY_PIXELS, view_octaves
 from core.skeleton import HINGE, human_template
 from core.tracker import (
-    REFERENCE_BODY_PIXELS,
     Tracker,
     TrackerSettings,
     _PointSet,
     depth_blind_joints,
     track,
-    view_octaves,
 )
 from support.synthetic import render, side_view
 
@@ -165,15 +164,15 @@ def test_views_of_different_sizes_each_read_the_level_where_the_body_is_as_large
     for t, p in ((tracker, mixed(pose)), (small, pose), (large, big)):
         t._scale_to(p)
     assert tracker.seq.levels == [3, 4]
-    assert [tracker._view_level(0, lv) for lv in range(4)] == [0, 0, 1, 2]
-    assert [tracker._view_level(1, lv) for lv in range(4)] == [0, 1, 2, 3]
-    assert tracker._search_level() == large._search_level() == 2
+    assert [tracker._scales.view_level(0, lv) for lv in range(4)] == [0, 0, 1, 2]
+    assert [tracker._scales.view_level(1, lv) for lv in range(4)] == [0, 1, 2, 3]
+    assert tracker._scales.search_level() == large._scales.search_level() == 2
 
     def points(t, p, view, lv):
         return len(t._point_set(p, Kinematics(sk, p), view, 0, lv, 1.0).value)
 
     for lv in range(4):
-        own = tracker._view_level(0, lv)
+        own = tracker._scales.view_level(0, lv)
         assert points(tracker, mixed(pose), 0, own) == points(small, pose, 0, own)
         assert points(tracker, mixed(pose), 1, lv) == points(large, big, 1, lv)
 
