@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -84,6 +85,18 @@ def one_step(job_path: Path, truth: tuple) -> evaluate.Scores:
     return evaluate.score(sk, tracked, (np.array(est_R), np.array(est_p)), truth)
 
 
+def track_job(job_path: Path, out: Path, rep_path: Path) -> tuple[int, float]:
+    """Run ``python -m core track`` on a job as a user would; its exit status and its peak
+    resident memory in MB (the whole process: Python, numpy, OpenCV and the tracker; Linux's
+    ``ru_maxrss``, read from the finished child alone). Its error output is passed on."""
+    cmd = [sys.executable, "-m", "core", "track", str(job_path), "--out", str(out),
+           "--report", str(rep_path), "--quiet"]
+    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL)
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    return proc.returncode, usage.ru_maxrss / 1024
+
+
 def fmt(x, digits=1):
     return "-" if x is None else f"{x:.{digits}f}"
 
@@ -116,13 +129,11 @@ def main(argv=None) -> int:
                              step / CAPTURE_FPS, joints, a.correct_every)
         out = job_path.with_suffix(".bvh")
         rep_path = job_path.with_suffix(".report.json")
-        cmd = [sys.executable, "-m", "core", "track", str(job_path), "--out", str(out),
-               "--report", str(rep_path), "--quiet"]
-        proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-        if proc.returncode not in (0, 3):
-            print(proc.stderr)
-            raise SystemExit(f"{name}: the tracker failed (exit {proc.returncode})")
+        code, peak_mb = track_job(job_path, out, rep_path)
+        if code not in (0, 3):
+            raise SystemExit(f"{name}: the tracker failed (exit {code})")
         rep = json.loads(rep_path.read_text())
+        rep["peak_mb"] = peak_mb
         job = load_job(job_path)
         sk = job.skeleton
         tracked_names = sk.tracked_joint_names()
@@ -147,8 +158,8 @@ def main(argv=None) -> int:
 
     print()
     print("| run | frames tracked | limb dir. err (8 limbs) | neck-head | joint pos. err |"
-          " held still | best fit | tracking fps | s / iteration |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          " held still | best fit | tracking fps | s / iteration | peak memory |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for name, (s, rep) in results.items():
         still, best = refs[ref_of[name]]
         first_div = rep["diverged_frames"][0] if rep["diverged_frames"] else None
@@ -156,7 +167,8 @@ def main(argv=None) -> int:
             f" (diverged at {first_div})" if first_div is not None else "")
         print(f"| {name} | {tracked} | {s.limb_mean_deg:.1f}° | {s.limb_deg['neck-head']:.1f}° |"
               f" {s.position_mm:.0f} mm | {still.limb_mean_deg:.1f}° | {best.limb_mean_deg:.1f}° |"
-              f" {fmt(rep['frames_per_second'])} | {fmt(rep['seconds_per_iteration'], 3)} |")
+              f" {fmt(rep['frames_per_second'])} | {fmt(rep['seconds_per_iteration'], 3)} |"
+              f" {rep['peak_mb']:.0f} MB |")
     print()
     names = list(results)
     # the references at 15 fps (else the first rate run): held still, and each body's best fit

@@ -55,6 +55,12 @@ class ImageSequence:
             self._grey[key] = self._read(view, frame)
         return self._grey[key]
 
+    def peek_grey(self, view: int, frame: int) -> np.ndarray:
+        """``grey``, without keeping the image for later (a glance at a frame the run may
+        not reach for a long time)."""
+        key = (view, frame)
+        return self._grey[key] if key in self._grey else self._read(view, frame)
+
     def set_levels(self, levels: Sequence[int]) -> None:
         """Build each view's pyramids with ``levels[view]`` levels from now on; those built
         already are dropped."""

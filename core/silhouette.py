@@ -12,7 +12,7 @@ level pixels, capped so that clutter far from the body cannot pull.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import cv2
@@ -38,7 +38,7 @@ class Backdrop:
     footage differ from it over far more than the body's area (a moving camera, changing
     light)."""
 
-    def __init__(self, grey: np.ndarray, body: np.ndarray, frames: Sequence[np.ndarray] = (),
+    def __init__(self, grey: np.ndarray, body: np.ndarray, frames: Iterable[np.ndarray] = (),
                  margin: int = BODY_MARGIN):
         grey = np.asarray(grey, np.float32)
         self.margin = margin

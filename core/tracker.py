@@ -264,8 +264,8 @@ class Tracker:
         others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
         for c in range(self.seq.n_views):
             grey = self.seq.grey(c, key_frame)
-            backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), [
-                self.seq.grey(c, f) for f in sorted(set(others) - {key_frame})],
+            backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), (
+                self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})),
                 sil.BODY_MARGIN * self._scales.magnification(c))
             if not backdrop.still:
                 self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
