@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import subprocess
 import sys
 import time
@@ -85,16 +84,30 @@ def one_step(job_path: Path, truth: tuple) -> evaluate.Scores:
     return evaluate.score(sk, tracked, (np.array(est_R), np.array(est_p)), truth)
 
 
+# ``python -m core`` that writes, as it exits, its peak resident memory (Linux's VmHWM, in kB)
+# to the file named by its first argument. (A child's ru_maxrss is no use here: Linux carries
+# the parent's high-water mark over fork and exec, and this script holds Blender.)
+_WITH_PEAK = """import atexit, runpy, sys
+out = sys.argv.pop(1)
+def peak():
+    hwm = [line.split()[1] for line in open("/proc/self/status") if line.startswith("VmHWM")]
+    open(out, "w").write(hwm[0])
+atexit.register(peak)
+runpy.run_module("core", run_name="__main__")
+"""
+
+
 def track_job(job_path: Path, out: Path, rep_path: Path) -> tuple[int, float]:
     """Run ``python -m core track`` on a job as a user would; its exit status and its peak
-    resident memory in MB (the whole process: Python, numpy, OpenCV and the tracker; Linux's
-    ``ru_maxrss``, read from the finished child alone). Its error output is passed on."""
-    cmd = [sys.executable, "-m", "core", "track", str(job_path), "--out", str(out),
-           "--report", str(rep_path), "--quiet"]
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL)
-    _, status, usage = os.wait4(proc.pid, 0)
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    return proc.returncode, usage.ru_maxrss / 1024
+    resident memory in MB (the whole process: Python, numpy, OpenCV and the tracker). Its
+    error output is passed on."""
+    peak = rep_path.with_suffix(".peak")
+    cmd = [sys.executable, "-c", _WITH_PEAK, str(peak), "track", str(job_path), "--out",
+           str(out), "--report", str(rep_path), "--quiet"]
+    code = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL).returncode
+    mb = int(peak.read_text()) / 1024
+    peak.unlink()
+    return code, mb
 
 
 def fmt(x, digits=1):
