@@ -115,7 +115,7 @@ def _quaternions(addon, arm, bones, frame):
 
 
 def test_a_keyed_correction_holds_its_frame_and_stays_the_users(bpy_module, registered,
-                                                               footage):
+                                                               footage, capfd):
     """Track with one iteration a level, re-pose the left knee on frame 4 and Key Correction,
     track again with three: frame 4 keeps the keyed pose (the knee as the user set it, the
     other bones as the scene showed them, not tracked again) in keys of the user's type,
@@ -134,7 +134,10 @@ def test_a_keyed_correction_holds_its_frame_and_stays_the_users(bpy_module, regi
     assert bpy.ops.twist.key_correction() == {"FINISHED"}
     scene.twist.tracker.iterations = 3
     scene.frame_set(1)
+    capfd.readouterr()
     assert bpy.ops.twist.track() == {"FINISHED"}
+    message = capfd.readouterr().out
+    assert "tracked 5 of 5 frames; 1 frame (4) held at the pose you keyed" in message
     again = {f: _quaternions(registered, arm, ["LeftKnee", "RightHip"], f) for f in (3, 4, 5)}
     assert np.allclose(again[4]["LeftKnee"][0], keyed, atol=1e-6)
     assert np.allclose(again[4]["RightHip"][0], first[4]["RightHip"][0], atol=1e-6)
