@@ -148,6 +148,36 @@ def test_a_keyed_correction_holds_its_frame_and_stays_the_users(bpy_module, regi
     assert _channel_frames(arm)["LeftKnee"] == {(4, "KEYFRAME")}
 
 
+def test_key_correction_keys_every_tracked_bone_as_the_users(bpy_module, registered):
+    """On the human template (ball hips, hinge knees): every tracked channel is keyed on the
+    frame as the user's, over a tracked key there too, and reads back as that frame's
+    correction with every tracked bone; a bone not tracked is not keyed."""
+    bpy = bpy_module
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.twist.add_template_armature(template="HUMAN")
+    scene, arm = bpy.context.scene, bpy.context.scene.twist.armature
+    addon = registered.twist_addon
+    sk = addon.bridge.tracked_skeleton(arm)
+    knee = arm.pose.bones["LeftKnee"]
+    free = [k for k in range(3) if not knee.lock_rotation[k]][0]
+    knee.rotation_mode = "XYZ"
+    knee.keyframe_insert("rotation_euler", index=free, frame=5, keytype="GENERATED")
+    scene.frame_set(5)
+    knee.rotation_euler[free] = 0.7
+    assert bpy.ops.twist.key_correction() == {"FINISHED"}
+    bag = addon.keyframes.channelbag(arm)
+    keyed = {(fc.data_path, fc.array_index): [(k.co[0], k.co[1], k.type)
+                                              for k in fc.keyframe_points]
+             for fc in bag.fcurves}
+    tracked = {(path, i) for _, path, i in addon.keyframes.channels(arm, sk)}
+    assert set(keyed) == tracked
+    assert all(keys == [(5.0, keys[0][1], "KEYFRAME")] for keys in keyed.values())
+    assert keyed['pose.bones["LeftKnee"].rotation_euler', free][0][1] == pytest.approx(0.7)
+    tracked_bones = {name for j, (name, kind) in enumerate(zip(sk.names, sk.kinds))
+                     if j == 0 or kind != "fixed"}
+    assert addon.keyframes.user_keys(arm, sk) == {5: frozenset(tracked_bones)}
+
+
 def _bvh_world(bvh, R, p):
     from core.skeleton import skeleton_from_bvh
 
