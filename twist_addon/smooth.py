@@ -8,13 +8,14 @@ import numpy as np
 
 from ..core.cycles import lowpass, lowpass_quaternions
 from .bridge import BridgeError, skeleton_from_armature
-from .keyframes import channelbag, tracked_fcurves
+from .keyframes import TRACKED, channelbag, tracked_fcurves
 from .reporting import ArmatureAction
 
 
 def smooth_track(arm, first: int, last: int, cutoff_hz: float, fps: float) -> int:
-    """Low-pass every tracked channel of ``arm`` over frames first..last (the keys on those
-    frames get the filtered values; keys elsewhere stay). Returns the channels smoothed."""
+    """Low-pass every tracked channel of ``arm`` over frames first..last: the keys tracking
+    wrote on those frames get the filtered values; the user's own (the first pose, the
+    corrections) and keys elsewhere stay. Returns the channels smoothed."""
     sk = skeleton_from_armature(arm)
     bag = channelbag(arm)
     curves = tracked_fcurves(arm, sk, bag) if bag is not None else []
@@ -39,7 +40,7 @@ def smooth_track(arm, first: int, last: int, cutoff_hz: float, fps: float) -> in
         for k, fc in enumerate(group):
             for kp in fc.keyframe_points:
                 i = int(round(kp.co[0])) - first
-                if 0 <= i < len(frames) and kp.co[0] == frames[i]:
+                if 0 <= i < len(frames) and kp.co[0] == frames[i] and kp.type == TRACKED:
                     kp.co[1] = smooth[i, k]
             fc.update()
     return len(curves)

@@ -1,5 +1,6 @@
 """twist.smooth_track on a keyed walk with jitter added: the jitter goes, the walk stays, a
-quaternion track that flips sign midway is smoothed as the rotation it is, other keys stay."""
+quaternion track that flips sign midway is smoothed as the rotation it is, the user's keys
+(other channels', and a corrected frame's) stay."""
 
 import numpy as np
 import pytest
@@ -50,6 +51,9 @@ def test_smoothing_removes_jitter_across_a_quaternion_flip(bpy_module, registere
     user = arm.pose.bones["Neck"]
     user.scale = (1.2, 1.2, 1.2)
     user.keyframe_insert("scale", frame=10)  # the user's own key, not tracking's
+    corrected = 20  # a frame the user corrected: its hip keys are the user's
+    for fc in hip:
+        fc.keyframe_points[corrected - scene.frame_start].type = "KEYFRAME"
     noisy = _rotations(bag, "LeftHip", frames)
     assert bpy.ops.twist.smooth_track(cutoff=3.0) == {"FINISHED"}
     smooth = _rotations(bag, "LeftHip", frames)
@@ -57,6 +61,9 @@ def test_smoothing_removes_jitter_across_a_quaternion_flip(bpy_module, registere
     assert _angle(smooth, clean).mean() < 0.6 * _angle(noisy, clean).mean()
     assert _angle(smooth, clean).max() < _angle(noisy, clean).max()  # no spike at the flip
     assert all(len(fc.keyframe_points) == len(frames) for fc in hip)
+    i = corrected - scene.frame_start
+    assert _angle(smooth[i:i + 1], noisy[i:i + 1])[0] < 1e-4  # the correction stays
+    assert _angle(smooth[i + 1:i + 2], noisy[i + 1:i + 2])[0] > 0.1  # its neighbours move
     neck_scale = [fc for fc in bag.fcurves if fc.data_path.endswith('"Neck"].scale')]
     assert neck_scale and all(fc.evaluate(10) == pytest.approx(1.2) for fc in neck_scale)
 
