@@ -263,6 +263,22 @@ class TWIST_OT_remove_view(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _pose_menu(self, context):
+    """Key Correction in pose mode's right-click menu, beside Insert Keyframe, for the
+    armature being tracked."""
+    if context.object is not None and context.object == context.scene.twist.armature:
+        self.layout.separator()
+        self.layout.operator(TWIST_OT_key_correction.bl_idname, icon="KEY_HLT")
+
+
+def register():
+    bpy.types.VIEW3D_MT_pose_context_menu.append(_pose_menu)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_pose_context_menu.remove(_pose_menu)
+
+
 CLASSES = (TWIST_OT_track, TWIST_OT_key_correction, TWIST_OT_clear_track,
            TWIST_OT_add_template_armature,
            TWIST_OT_add_view, TWIST_OT_remove_view)

@@ -2,6 +2,7 @@
 imported from the capture, posed on the first frame, three orthographic cameras."""
 
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ from walk_footage import JOINTS, render, tracking_scene  # noqa: E402
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
-from support.layout import draw_panel  # noqa: E402
+from support.layout import Recorder, draw_panel  # noqa: E402
 
 VIEWS = ["lateral", "endon", "oblique60"]
 TRACKED = list(JOINTS)
@@ -176,6 +177,12 @@ def test_key_correction_keys_every_tracked_bone_as_the_users(bpy_module, registe
     tracked_bones = {name for j, (name, kind) in enumerate(zip(sk.names, sk.kinds))
                      if j == 0 or kind != "fixed"}
     assert addon.keyframes.user_keys(arm, sk) == {5: frozenset(tracked_bones)}
+    # offered in pose mode's right-click menu for the tracked armature
+    menu = bpy.types.VIEW3D_MT_pose_context_menu
+    assert addon.operators._pose_menu in menu.draw._draw_funcs
+    layout = Recorder()
+    addon.operators._pose_menu(types.SimpleNamespace(layout=layout), bpy.context)
+    assert ("operator", ("twist.key_correction",)) in [(n, a) for n, a, _ in layout.calls]
 
 
 def _bvh_world(bvh, R, p):
