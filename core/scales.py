@@ -12,7 +12,7 @@ where that is below 0), so that the body is about as large in every view on ever
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -43,13 +43,19 @@ class Scales:
     silhouette_cap: float
 
     @classmethod
+    def unscaled(cls, n_views: int, settings) -> Scales:
+        """The tracker's ``settings`` as they are, in every view (no octaves)."""
+        return cls((0,) * n_views, settings.levels, settings.pixel_step,
+                   settings.silhouette_cap)
+
+    @classmethod
     def of(cls, skeleton: Skeleton, pose: BodyPose, settings) -> Scales:
         """The scales for the body at ``pose`` (every view's octaves 0 unless the tracker's
         ``settings`` ask for ``auto_scale``)."""
-        octaves = (view_octaves(skeleton, pose) if settings.auto_scale
-                   else [0] * len(pose.views))
-        return cls(tuple(octaves), settings.levels, settings.pixel_step,
-                   settings.silhouette_cap)
+        unscaled = cls.unscaled(len(pose.views), settings)
+        if not settings.auto_scale:
+            return unscaled
+        return replace(unscaled, octaves=tuple(view_octaves(skeleton, pose)))
 
     def pyramid_levels(self) -> list[int]:
         """Per view, the levels of its pyramid."""

@@ -207,8 +207,7 @@ class Tracker:
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
-        self._scales = Scales((0,) * self.seq.n_views, self.settings.levels,
-                              self.settings.pixel_step, self.settings.silhouette_cap)
+        self._scales = Scales.unscaled(self.seq.n_views, self.settings)  # as seq is built
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
         self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
         self.n_dof = len(self._dof_joint)
