@@ -60,10 +60,12 @@ RUNS = {
 }
 
 
-def one_step(job_path: Path, truth: tuple) -> evaluate.Scores:
+def one_step(job_path: Path, truth: tuple, at_truth: bool = False) -> evaluate.Scores:
     """Each frame tracked alone from the true pose of the frame before, predicted from the true
     poses of the two before (the first from the one before): how well a single step follows
-    the body, apart from how errors add up along the sequence."""
+    the body, apart from how errors add up along the sequence. With ``at_truth`` the
+    prediction is the frame's own true pose: where the tracker's cost has its minimum, apart
+    from how far its prediction and search start from it."""
     from core.pose import BodyPose, extrapolate
     from core.tracker import Tracker
 
@@ -76,7 +78,8 @@ def one_step(job_path: Path, truth: tuple) -> evaluate.Scores:
 
     est_R, est_p = [truth[0][0]], [truth[1][0]]
     for i in range(1, len(truth[0])):
-        pred = pose(i - 1) if i == 1 else extrapolate(pose(i - 2), pose(i - 1))
+        pred = (pose(i) if at_truth else pose(i - 1) if i == 1
+                else extrapolate(pose(i - 2), pose(i - 1)))
         res = tracker.track_frame(pose(i - 1), i - 1, pose(0), 0, pred, i)
         est_R.append(res.pose.rotations)
         est_p.append(res.pose.root_position)
@@ -165,6 +168,7 @@ def main(argv=None) -> int:
             )
         if mode == "calibrated" and len(views) == 3:
             steps[name] = one_step(job_path, truth)
+            steps[name + ", at the truth"] = one_step(job_path, truth, at_truth=True)
         s = results[name][0]
         print(f"{name}: limb {s.limb_mean_deg:.1f} deg, {rep['frames_tracked']}/"
               f"{rep['frames_total']} frames, {rep['frames_per_second']:.1f} fps", flush=True)
@@ -206,13 +210,17 @@ def main(argv=None) -> int:
         cells += [fmt(b.local_deg.get(joint)) for b in bests.values()]
         print(f"| {joint} | " + " | ".join(cells) + " |")
     if steps:
-        print("\n| one step from the true pose (°) | " + " | ".join(steps) + " |")
+        print("\n| one step from the true pose (°; *at the truth*: predicted at the frame's own)"
+              " | " + " | ".join(steps) + " |")
         print("|---" * (len(steps) + 1) + "|")
         for limb in next(iter(steps.values())).limb_deg:
             print(f"| {limb} | " + " | ".join(f"{s.limb_deg[limb]:.1f}" for s in steps.values())
                   + " |")
         print("| mean of the eight limbs | " + " | ".join(
             f"{s.limb_mean_deg:.1f}" for s in steps.values()) + " |")
+        print("| worst frame (its eight limbs' mean) | " + " | ".join(
+            f"{s.per_frame_limb_deg.max():.1f} (frame {s.per_frame_limb_deg.argmax()})"
+            for s in steps.values()) + " |")
     print(f"\nbenchmark time {time.perf_counter() - t0:.0f} s; {WIDTH * a.zoom}x"
           f"{HEIGHT * a.zoom} footage, "
           f"{len(JOINTS)} tracked joints (19 degrees of freedom), + spine "
