@@ -3,7 +3,7 @@ with a skeleton whose left knee sits 4 cm forward of the capture's and whose rig
 is turned 15 degrees, refined (core.refine), and scored before and after.
 
     python bench/refine_benchmark.py [--cache .cache/walk] [--first 60] [--last 119]
-                                     [--rounds 10] [--zoom 1] [--spine]
+                                     [--rounds 10] [--zoom 1] [--spine] [--settings JSON]
 
 Frames are indices into the 30 fps footage (the default stretch is its steady walking, to
 the end); the refinement runs until the joints settle or ``--rounds`` are done. Prints each
@@ -13,11 +13,14 @@ as the floor those errors read against, what the same estimate makes of each joi
 capture's own poses instead of tracked ones (no tracking error to carry). With
 ``--zoom 2`` the footage is 960x720 of the same stage (cached in .cache/walk2x), to tell
 what the footage's resolution decides from what it does not.
+With ``--settings`` the refinement tracks and reads with those tracker settings (the legs
+are scored with the defaults).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -45,7 +48,7 @@ from core.job import load_job  # noqa: E402
 from core.pose import BodyPose  # noqa: E402
 from core.refine import carried_pose, joint_from_track, moved_joint, refine  # noqa: E402
 from core.skeleton import Skeleton  # noqa: E402
-from core.tracker import Tracker, track  # noqa: E402
+from core.tracker import Tracker, TrackerSettings, track  # noqa: E402
 
 LEGS = ["left thigh", "right thigh", "left shank", "right shank"]
 
@@ -69,12 +72,14 @@ def leg_errors(sk, truth_sk, images, initial, truth, frames) -> dict[str, float]
             for k in LEGS}
 
 
-def at_capture(sk, images, truth, cameras, joints: list[int]) -> dict[int, Skeleton]:
+def at_capture(sk, images, truth, cameras, joints: list[int], settings: TrackerSettings
+               ) -> dict[int, Skeleton]:
     """Per joint, ``sk`` with that joint where ``core.refine`` reads it (centre and hinge axis)
-    from the footage at the capture's own poses ``truth`` (rotations, roots) of every frame
-    of ``images``: one tracker, so each frame is read and filtered once."""
+    from the footage, filtered as ``settings`` say, at the capture's own poses ``truth``
+    (rotations, roots) of every frame of ``images``: one tracker, so each frame is read and
+    filtered once."""
     poses = [BodyPose(R.copy(), p.copy(), [c.copy() for c in cameras]) for R, p in zip(*truth)]
-    tracker = Tracker(sk, images, "calibrated")
+    tracker = Tracker(sk, images, "calibrated", settings)
     return {j: moved_joint(sk, j, *joint_from_track(tracker, poses, range(len(poses)), j))
             for j in joints}
 
@@ -84,6 +89,9 @@ def main(argv=None) -> int:
     ap.add_argument("--first", type=int, default=60)
     ap.add_argument("--last", type=int, help="one past the last frame (default: the end)")
     ap.add_argument("--rounds", type=int, default=10, help="track-and-refine rounds, at most")
+    ap.add_argument("--settings", default="{}",
+                    help="tracker settings (JSON) of the refinement (the legs are scored "
+                         "with the defaults)")
     add_footage_arguments(ap)
     add_spine_argument(ap)
     a = ap.parse_args(argv)
@@ -110,7 +118,9 @@ def main(argv=None) -> int:
     guess = moved_joint(moved_joint(truth_sk, lk, np.array([0.0, 0.0, 0.04])), rk,
                         np.zeros(3), turned)
     initial = carried_pose(truth_sk, guess, initial_true)  # lined up, centres wrong
-    result = refine(guess, images, initial, ["LeftKnee", "RightKnee"], rounds=a.rounds)
+    settings = TrackerSettings(**json.loads(a.settings))
+    result = refine(guess, images, initial, ["LeftKnee", "RightKnee"], settings,
+                    rounds=a.rounds)
     refined = result.skeleton
 
     settled = "settled" if result.settled() else "not settled"
@@ -119,7 +129,7 @@ def main(argv=None) -> int:
     print("| joint | centre error before | after | axis error before | after | after, against"
           " the capture's own axis | read at the capture's poses |")
     print("|---|---|---|---|---|---|---|")
-    floors = at_capture(truth_sk, images, truth, job.cameras, [lk, rk])
+    floors = at_capture(truth_sk, images, truth, job.cameras, [lk, rk], settings)
     for j in (lk, rk):
         def centre(s, j=j):
             return 100 * np.linalg.norm(s.rest_positions[j] - truth_sk.rest_positions[j])
