@@ -120,10 +120,13 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
     if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
         return []
     frames = Kinematics(skeleton, pose).frames
-    dof_joints = sorted(set(skeleton.dof_joints_and_axes()[0].tolist()))
-    return [skeleton.names[j] for j in dof_joints
-            if skeleton.kinds[j] != HINGE
-            or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON]
+    blind = []
+    for name in skeleton.tracked_joint_names():
+        j = skeleton.index(name)
+        if (skeleton.kinds[j] != HINGE
+                or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON):
+            blind.append(name)
+    return blind
 
 
 @dataclass
