@@ -69,6 +69,10 @@ class Scales:
         """The pyramid level of ``view`` that tracker level ``level`` reads."""
         return max(level - (max(self.octaves) - self.octaves[view]), 0)
 
+    def view_levels(self, level: int) -> list[int]:
+        """Every view's pyramid level that tracker level ``level`` reads."""
+        return [self.view_level(c, level) for c in range(len(self.octaves))]
+
     def search_level(self) -> int:
         """The tracker level the limbs are searched on, after the coarser ones placed the
         body."""

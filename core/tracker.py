@@ -289,8 +289,7 @@ class Tracker:
         if self.settings.silhouette <= 0:
             return est
         self._learn_first_backdrops(key, key_frame)
-        lvs = [self._scales.view_level(c, self._scales.search_level())
-               for c in range(self.seq.n_views)]
+        lvs = self._scales.view_levels(self._scales.search_level())
         fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
                for c, (b, lv) in enumerate(zip(self._backdrops, lvs))]
         if all(f is None for f in fgs):
@@ -384,7 +383,7 @@ class Tracker:
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
-        lvs = [self._scales.view_level(c, level) for c in range(self.seq.n_views)]
+        lvs = self._scales.view_levels(level)
         gs = [self._scales.grid(c, lv) for c, lv in enumerate(lvs)]
         maps = [self._label_map(est, kin, c, levels[c].shape, lvs[c], gs[c])
                 for c in range(self.seq.n_views)]
@@ -552,7 +551,7 @@ class Tracker:
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for level in reversed(range(self._scales.n_levels())):
-            lvs = [self._scales.view_level(c, level) for c in range(self.seq.n_views)]
+            lvs = self._scales.view_levels(level)
             levels = [self.seq.pyramid(c, frame)[lv] for c, lv in enumerate(lvs)]
             sets = []  # per view, the previous frame's points then the key frame's
             for c, lv in enumerate(lvs):
