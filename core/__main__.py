@@ -15,7 +15,7 @@ import sys
 
 from .bvh import write_bvh
 from .image import ImageError
-from .init_fit import FitError, fit_pose
+from .init_fit import FitError, fit_pose, least_certain
 from .job import JobError, load_fit, load_job, world_root
 from .run import report, result_bvh, timed_run, write_report
 
@@ -69,6 +69,7 @@ def _fit(args) -> int:
     write_bvh(out, args.out)
     print(f"fitted {sum(len(c) for c in job.clicks)} clicks, {res.residual_px:.2f} px RMS"
           f" -> {args.out}", file=sys.stderr)
+    print(f"least certain bones: {least_certain(res.direction_uncertainty)}", file=sys.stderr)
     return 0
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..core.init_fit import FitError, fit_pose
+from ..core.init_fit import FitError, fit_pose, least_certain
 from ..core.job import world_root
 from ..core.pose import BodyPose
 from .bridge import (
@@ -83,10 +83,10 @@ def scale_bones(arm, factors: dict[str, float]) -> None:
     view_layer.objects.active = active
 
 
-def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, float]]:
+def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, float], str]:
     """Pose the scene's armature to its views' markers, and with ``fit_lengths`` scale its
-    bones to them too; returns the RMS pixel error and the length factor of every bone
-    whose length changed."""
+    bones to them too; returns the RMS pixel error, the length factor of every bone whose
+    length changed, and which bones the markers pin least (``init_fit.least_certain``)."""
     tw = scene.twist
     arm = tw.armature
     if arm is None:
@@ -113,7 +113,7 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
     R_fit = res.pose.rotations.copy()
     R_fit[0], root_fit = world_root(mode, views[0], res.pose)
     set_pose(arm, sk, R_fit, root_fit)
-    return res.residual_px, changed
+    return res.residual_px, changed, least_certain(res.direction_uncertainty)
 
 
 class TWIST_OT_import_markers(ArmatureAction, bpy.types.Operator):
@@ -147,12 +147,12 @@ class TWIST_OT_fit_pose(ArmatureAction, bpy.types.Operator):
                     "the lengths into the armature's rest pose")
 
     def run(self, context) -> str:
-        rms, changed = fit_armature(context.scene, self.fit_lengths)
+        rms, changed, uncertain = fit_armature(context.scene, self.fit_lengths)
         context.view_layer.update()
         lengths = (", ".join(f"{n} x{f:.3f}" for n, f in sorted(changed.items()))
                    if changed else "")
         return (f"fitted: joints {rms:.1f} px from their markers (RMS)"
-                + (f"; lengths {lengths}" if lengths else ""))
+                + (f"; lengths {lengths}" if lengths else "") + f"; least certain: {uncertain}")
 
 
 CLASSES = (TWIST_OT_import_markers, TWIST_OT_fit_pose)

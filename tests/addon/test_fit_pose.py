@@ -1,6 +1,8 @@
 """twist.import_markers and twist.fit_pose: markers in three views bring the armature back to
 the pose they were projected from."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -21,7 +23,7 @@ def _random_pose(bpy, arm, sk, rng, ball: float, hinge: float) -> None:
     bpy.context.view_layer.update()
 
 
-def test_fitting_markers_recovers_the_pose(bpy_module, registered, tmp_path):
+def test_fitting_markers_recovers_the_pose(bpy_module, registered, tmp_path, capfd):
     bpy = bpy_module
 
     scene, arm = _scene_with_views(bpy, registered)
@@ -47,11 +49,17 @@ def test_fitting_markers_recovers_the_pose(bpy_module, registered, tmp_path):
     for v in scene.twist.views:  # markers of another frame, far off: the fit ignores them
         for name in sk.names:
             registered.twist_addon.markers.set_marker(v, name, scene.frame_current + 5, 0, 0)
+    capfd.readouterr()
     assert bpy.ops.twist.fit_pose() == {"FINISHED"}
     bpy.context.view_layer.update()
     R2, root2 = tw.bridge.pose_from_armature(arm, sk)
     got = sk.world_positions(R2, root2)
     assert np.abs(got - truth).max() < 0.01  # metres
+    # the message names the bones the markers pin least (tests/core/test_init_fit.py checks
+    # the numbers against the fit's scatter)
+    said = re.search(r"least certain: (\w+) \+-[\d.]+, (\w+) \+-[\d.]+, (\w+) \+-[\d.]+ "
+                     r"degrees per pixel of click error", capfd.readouterr().out)
+    assert said and set(said.groups()) <= set(sk.tracked_joint_names()), said
 
 
 def test_bad_markers_are_refused(bpy_module, registered, tmp_path):

@@ -134,6 +134,45 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
     assert res.residual_px < 2 * noise
 
 
+def test_each_limbs_reported_uncertainty_is_the_scatter_of_its_fit_over_click_noise(cmu_walk):
+    # the fit reports, per bone, the RMS direction error that its information matrix bounds
+    # for a pixel of click error. Checked against the fit itself: the same body and clicks
+    # refitted under sixteen draws of 1 px noise scatter each limb's direction by what was
+    # reported (measured: ratios 0.91-1.28 by limb, 1.08 pooled; 0.94-1.15 and 1.02 for
+    # other draws), so the fit gets out of the clicks what they hold and no more can be had
+    b, guess_sk = _body(cmu_walk)
+    true_sk = _scaled(guess_sk, np.random.default_rng(0))
+    R_guess, p_guess = b.frame_pose(590)
+    R_true, p_true = _representable(guess_sk, R_guess, *b.frame_pose(600))
+    views = _views(3)
+    X = true_sk.world_positions(R_true, p_true)
+    errs, reported = [], []
+    for seed in range(16):
+        clicks = _clicks(true_sk, R_true, p_true, views, np.random.default_rng(100 + seed))
+        res = fit_pose(guess_sk, BodyPose(R_guess, p_guess, views), clicks, CALIBRATED)
+        Y = res.skeleton.world_positions(res.pose.rotations, res.pose.root_position)
+        errs.append([np.degrees(se3.angle_between_vectors(
+            Y[true_sk.index(c)] - Y[true_sk.index(a)], X[true_sk.index(c)] - X[true_sk.index(a)]))
+            for a, c in LIMBS])
+        reported.append([res.direction_uncertainty[a] for a, _ in LIMBS])
+    scatter = np.sqrt(np.mean(np.square(errs), axis=0))
+    bound = np.mean(reported, axis=0)
+    assert np.all((scatter > 0.6 * bound) & (scatter < 1.6 * bound)), (scatter, bound)
+    pooled = np.sqrt(np.mean(np.square(errs)) / np.mean(np.square(reported)))
+    assert 0.85 < pooled < 1.25, pooled
+    # the forearm whose wrist one view misses is the least certain limb, and at 1 px more
+    # than the 2 degrees the issue asks of every limb
+    assert max(bound) == bound[LIMBS.index(("LeftElbow", "LeftWrist"))] > 1.7
+
+    # fewer views hold less: one view, lengths known, reports every limb less certain,
+    # some of them by far (the turn toward the camera shows only in foreshortening)
+    clicks = _clicks(true_sk, R_true, p_true, views[:1], np.random.default_rng(100))
+    one = fit_pose(true_sk, BodyPose(R_guess, p_guess, views[:1]), clicks, CALIBRATED,
+                   fit_lengths=False).direction_uncertainty
+    one = np.array([one[a] for a, _ in LIMBS])
+    assert np.all(one > bound) and max(one) > 5 * max(bound), one
+
+
 def test_one_view_with_known_lengths_recovers_each_clicked_limb_up_to_its_mirror_in_depth(
         cmu_walk):
     # one orthographic view shows a limb's image and, given its length, the size of its depth
@@ -194,6 +233,7 @@ def test_one_view_with_click_noise_recovers_each_limb_in_the_image_plane(cmu_wal
 
 def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
     import json
+    import re
     import subprocess
     import sys
 
@@ -223,6 +263,11 @@ def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
                            "--out", str(tmp_path / "fitted.bvh")], cwd=root,
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
+    # the bones the clicks pin least: the neck's (its ends 9 cm apart) and the forearm whose
+    # wrist one view misses
+    assert re.search(r"least certain bones: Neck \+-2\.\d, LeftElbow \+-1\.\d, "
+                     r"RightElbow \+-1\.\d degrees per pixel of click error", proc.stderr), \
+        proc.stderr
     got = read_bvh(tmp_path / "fitted.bvh")
     assert len(got.motion) == 1 and got.names == b.names
     fitted = skeleton_from_bvh(got)
@@ -240,7 +285,7 @@ def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
     assert "bad.json.clicks: expected one object per view (3), got 2" in proc.stderr
     one = dict(fit, views=fit["views"][:1], clicks=fit["clicks"][:1])
     for name, extra, code, says in [("one.json", {}, 2, "one view cannot tell a longer bone"),
-                                    ("pose.json", {"fit_lengths": False}, 0, "fitted")]:
+                                    ("pose.json", {"fit_lengths": False}, 0, "not pinned")]:
         (tmp_path / name).write_text(json.dumps(dict(one, **extra)))
         proc = subprocess.run([sys.executable, "-m", "core", "fit", str(tmp_path / name),
                                "--out", str(tmp_path / "x.bvh")], cwd=root,
