@@ -81,6 +81,19 @@ def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:
     return bvh.poses()
 
 
+def in_the_image_plane(sk: Skeleton, truth: tuple, sight: np.ndarray) -> dict[str, float]:
+    """Mean limb-direction error (degrees) of limbs read exactly in the image of one view
+    looking along ``sight`` (a world direction) with nothing read in depth: each true limb
+    laid into the image plane. What a single view leaves to be inferred about depth."""
+    vt = limb_vectors(sk, *truth)
+    sight = np.asarray(sight, dtype=float) / np.linalg.norm(sight)
+    per = {k: np.degrees(se3.angle_between_vectors(v, v - np.outer(v @ sight, sight)))
+           for k, v in vt.items()}
+    out = {k: float(v.mean()) for k, v in per.items()}
+    out["mean"] = float(np.mean([per[k] for k in HEADLINE]))
+    return out
+
+
 def held_still(truth: tuple) -> tuple:
     """The first frame's pose repeated over every frame, root included."""
     R, p = truth

@@ -1,0 +1,33 @@
+"""The benchmark's scores against cases whose answer geometry gives."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from core import se3
+from core.bvh import read_bvh
+from core.skeleton import skeleton_from_bvh
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+
+import evaluate  # noqa: E402
+
+
+def test_limbs_laid_into_the_image_plane_are_off_by_their_angle_out_of_it(cmu_walk):
+    b = read_bvh(cmu_walk)
+    sk = skeleton_from_bvh(b)
+    R, p = b.frame_pose(0)
+    R[:] = np.eye(3)  # the rest pose, in which the capture's thighs lie in the x-y plane
+    R[sk.index("LeftHip")] = se3.exp_so3([0.0, 0.0, np.radians(30)])  # swung within it
+    truth = (R[None], p[None])
+    # seen along z the left thigh lies in the image plane; seen along x or y it leans out of
+    # it by the angle its x or y component makes, which add up to 90 degrees
+    along_z = evaluate.in_the_image_plane(sk, truth, [0, 0, 1])
+    along_x = evaluate.in_the_image_plane(sk, truth, [1, 0, 0])
+    along_y = evaluate.in_the_image_plane(sk, truth, [0, 1, 0])
+    thigh = evaluate.limb_vectors(sk, *truth)["left thigh"][0]
+    assert along_z["left thigh"] < 1e-6
+    expected = np.degrees(np.arcsin(abs(thigh[0]) / np.linalg.norm(thigh)))
+    assert abs(along_x["left thigh"] - expected) < 1e-6
+    assert abs(along_y["left thigh"] - (90 - expected)) < 1e-6
