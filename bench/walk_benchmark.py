@@ -170,7 +170,7 @@ def main(argv=None) -> int:
         if len(views) == 1:  # what that view shows without depth
             sight = np.array(info["cameras"][views[0]]["R"])[2]
             flat[name] = evaluate.in_the_image_plane(sk, truth, sight)["mean"]
-        if mode == "calibrated" and len(views) == 3:
+        if mode == "calibrated":
             steps[name] = one_step(job_path, truth)
             steps[name + ", at the truth"] = one_step(job_path, truth, at_truth=True)
         s = results[name][0]
