@@ -81,6 +81,22 @@ def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:
     return bvh.poses()
 
 
+def image_error_px(sk: Skeleton, est: tuple, truth: tuple, views: list) -> float:
+    """Mean distance (pixels) between tracked and true limb ends (the joints of ``LIMBS``)
+    as each of ``views`` (``core.camera.View``) shows them: how far the tracked body's
+    overlay strays from the body in the footage, which even one view sees."""
+    F = min(len(est[0]), len(truth[0]))
+    ends = sorted({name for _, a, b in LIMBS for name in (a, b)})
+
+    def points(poses):
+        frames = [sk.joint_frames(R, p) for R, p in zip(poses[0][:F], poses[1][:F])]
+        return np.array([[_point(sk, M, n) for n in ends] for M in frames]).reshape(-1, 3)
+
+    pe, pt = points(est), points(truth)
+    return float(np.mean([np.linalg.norm(v.project(pe) - v.project(pt), axis=1).mean()
+                          for v in views]))
+
+
 def in_the_image_plane(sk: Skeleton, truth: tuple, sight: np.ndarray) -> dict[str, float]:
     """Mean limb-direction error (degrees) of limbs read exactly in the image of one view
     looking along ``sight`` (a world direction) with nothing read in depth: each true limb

@@ -31,3 +31,21 @@ def test_limbs_laid_into_the_image_plane_are_off_by_their_angle_out_of_it(cmu_wa
     expected = np.degrees(np.arcsin(abs(thigh[0]) / np.linalg.norm(thigh)))
     assert abs(along_x["left thigh"] - expected) < 1e-6
     assert abs(along_y["left thigh"] - (90 - expected)) < 1e-6
+
+
+def test_the_image_error_is_how_far_each_view_sees_the_limb_ends_moved(cmu_walk):
+    from core.camera import View
+
+    b = read_bvh(cmu_walk)
+    sk = skeleton_from_bvh(b)
+    R, p = b.frame_pose(600)
+    truth = (R[None], p[None])
+    side = View(se3.Similarity(150.0, np.diag([1.0, -1, -1]), np.zeros(3)), np.zeros(2))
+    front = View(se3.Similarity(150.0, np.diag([1.0, -1, -1]) @ se3.exp_so3([0, np.pi / 2, 0]),
+                                np.zeros(3)), np.zeros(2))
+    # the whole body 2 cm along the first view's line of sight: that view sees nothing move,
+    # one at right angles sees every limb end move 3 pixels
+    moved = (R[None], (p + [0.0, 0.0, 0.02])[None])
+    assert evaluate.image_error_px(sk, moved, truth, [side]) < 1e-9
+    assert abs(evaluate.image_error_px(sk, moved, truth, [front]) - 3.0) < 1e-9
+    assert abs(evaluate.image_error_px(sk, moved, truth, [side, front]) - 1.5) < 1e-9
