@@ -355,15 +355,16 @@ def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list
               cameras: dict, settings: dict, frame_time: float, joints: dict = JOINTS,
               correct_every: int = 0) -> Path:
     """Write folder/jobs/<name>.json tracking the given rendered frames (capture indices) of
-    the given views with the tracked ``joints``; the skeleton and initial pose come from
-    folder/truth.bvh's first frame, which must be the first of ``frames``. With
-    ``correct_every`` N, every N-th frame is corrected to the capture's pose there, as a
-    user who keyed it would."""
+    the given views with the tracked ``joints``; the skeleton comes from folder/truth.bvh
+    and the initial pose from its frame of the first of ``frames``. With ``correct_every``
+    N, every N-th frame is corrected to the capture's pose there, as a user who keyed it
+    would."""
     jobs = folder / "jobs"
     jobs.mkdir(exist_ok=True)
+    truth_frames = json.loads((folder / "footage.json").read_text())["frames"]  # truth.bvh
     job = {
         "skeleton": {"bvh": "../truth.bvh", "joints": joints, "blobs": BLOBS},
-        "initial": {"bvh": "../truth.bvh", "frame": 0},
+        "initial": {"bvh": "../truth.bvh", "frame": truth_frames.index(frames[0])},
         "views": [{"images": [f"../{v}/{f:04d}.png" for f in frames], "camera": cameras[v]}
                   for v in views],
         "mode": mode,
@@ -371,13 +372,24 @@ def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list
         "frame_time": frame_time,
     }
     if correct_every:
-        truth_frames = json.loads((folder / "footage.json").read_text())["frames"]  # truth.bvh
         job["corrections"] = [{"image": i, "bvh": "../truth.bvh",
                                "frame": truth_frames.index(frames[i])}
                               for i in range(correct_every, len(frames), correct_every)]
     path = jobs / f"{name}.json"
     path.write_text(json.dumps(job, indent=1))
     return path
+
+
+def side_on_hinges(folder: Path, frame: int, view: str, cameras: dict) -> dict:
+    """JOINTS as hinges about ``view``'s line of sight at capture ``frame`` (the paper's
+    single-camera body: every joint turns in the image plane), axes in each joint's frame."""
+    truth = read_bvh(folder / "truth.bvh")
+    sk = skeleton_from_bvh(truth)
+    frames = sk.joint_frames(*truth.frame_pose(
+        json.loads((folder / "footage.json").read_text())["frames"].index(frame)))
+    sight = np.array(cameras[view]["R"])[2]
+    return {name: {"kind": "hinge", "axis": (frames[sk.index(name), :3, :3].T @ sight).tolist()}
+            for name in JOINTS}
 
 
 def add_footage_arguments(ap) -> None:
