@@ -23,6 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+UNSEEN = 1e-12  # an unknown whose information is under this share of the largest is unseen
+
 
 class DegenerateSystem(RuntimeError):
     """The linear system has no usable solution (no pixels, or singular after damping)."""
@@ -97,9 +99,11 @@ def solve(
     d = np.diag(H).copy()
     pw = np.zeros(P) if prior is None else prior
     # Jacobi scaling keeps radians, pixels and scale on one footing for the factorisation;
-    # an unknown no pixel sees (an all-zero column) gets a unit diagonal and stays put
+    # an unknown no pixel sees gets a unit diagonal and stays put. "No pixel" includes a
+    # column of rounding errors (a root's translation along the line of sight of one view
+    # that is not aligned with the world's axes): scaled up, it was flung 1e5-1e11 metres
     diag = d * (1 + damping) + pw
-    diag[diag <= 0] = 1.0
+    diag[diag <= UNSEEN * max(float(diag.max()), 0.0)] = 1.0
     S = 1 / np.sqrt(diag)
     M = (H - np.diag(d)) * S[:, None] * S[None, :] + np.eye(P)
     rhs = -(b + (pw * offset if offset is not None else 0.0)) * S

@@ -47,6 +47,24 @@ def test_inactive_unknowns_stay_put_and_the_rest_solve_their_subsystem():
     np.testing.assert_allclose(step[active], np.linalg.lstsq(sub, -r, rcond=None)[0], rtol=1e-9)
 
 
+def test_an_unknown_only_rounding_errors_see_stays_put():
+    """A column of rounding errors (1e-17 of the others: a root's translation along the line
+    of sight of one view turned off the world's axes) is an unknown nothing sees; scaled like
+    the rest it took a step of about a million, now none, and the others solve as without it."""
+    rng = np.random.default_rng(3)
+    A, r = rng.normal(size=(60, 4)), rng.normal(size=60)
+    A[:, 2] = rng.normal(size=60) * 1e-17
+    ne = NormalEquations.zeros(4)
+    ne.add(A, r, np.ones(60))
+    for lam in (1e-6, 1e-2):
+        step = solve(ne, lam)
+        assert abs(step[2]) < 1e-9
+        rest = [0, 1, 3]
+        H = A[:, rest].T @ A[:, rest]
+        expect = np.linalg.solve(H + lam * np.diag(np.diag(H)), -(A[:, rest].T @ r))
+        np.testing.assert_allclose(step[rest], expect, rtol=1e-9)
+
+
 def test_no_rows_is_reported():
     with pytest.raises(DegenerateSystem, match="no usable pixels"):
         solve(NormalEquations.zeros(3), 1e-3)
