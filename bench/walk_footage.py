@@ -380,18 +380,6 @@ def write_job(folder: Path, name: str, views: list[str], mode: str, frames: list
     return path
 
 
-def side_on_hinges(folder: Path, frame: int, view: str, cameras: dict) -> dict:
-    """JOINTS as hinges about ``view``'s line of sight at capture ``frame`` (the paper's
-    single-camera body: every joint turns in the image plane), axes in each joint's frame."""
-    truth = read_bvh(folder / "truth.bvh")
-    sk = skeleton_from_bvh(truth)
-    frames = sk.joint_frames(*truth.frame_pose(
-        json.loads((folder / "footage.json").read_text())["frames"].index(frame)))
-    sight = np.array(cameras[view]["R"])[2]
-    return {name: {"kind": "hinge", "axis": (frames[sk.index(name), :3, :3].T @ sight).tolist()}
-            for name in JOINTS}
-
-
 def add_footage_arguments(ap) -> None:
     """``--zoom`` (footage that many times the size, the same stage in more pixels) and
     ``--cache`` (where it is rendered); read them back with ``footage_cache``."""

@@ -238,9 +238,10 @@ def refine(skeleton: Skeleton, images: Sequence[Sequence], initial: BodyPose,
     # soaked up the mismatch the refinement reads (a knee 4 cm off stayed 3.9 cm off, 1.4
     # without it, in the add-on's test); and with REFINE_ITERATIONS a level at least, since
     # the refinement reads what converged steps leave (with three, the planar chain's test
-    # diverged at its last frame)
+    # diverged at its last frame); and with the joints as given, which side-on tracking
+    # would change (``planar`` is the refinement for a body seen side-on)
     settings = settings or TrackerSettings()
-    settings = dataclasses.replace(settings, limb_search=0.0,
+    settings = dataclasses.replace(settings, limb_search=0.0, side_on=False,
                                    iterations=max(settings.iterations, REFINE_ITERATIONS))
     idx = []
     for name in joints:

@@ -98,6 +98,11 @@ class TrackerSettings:
                               "than brightness reaches. Needs cameras that stand still")
     silhouette_cap: float = _knob(24.0, "Farthest a silhouette mismatch pulls, in pixels of "
                                   "the full image")
+    side_on: bool = _knob(False, "With one view (or views along one line): track every "
+                          "joint that could turn toward or away from the camera as a hinge "
+                          "about the line of sight at the first frame, as the paper does "
+                          "with one camera: the limbs follow the footage in the image, and "
+                          "nothing moves in depth")
     limb_search: float = _knob(0.1, "Before refining a frame, turn each limb over a grid of "
                                "angles against the silhouette and keep the best turn when it "
                                "beats the prediction by this share of the limb's outline, "
@@ -127,6 +132,25 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
                 or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON):
             blind.append(name)
     return blind
+
+
+def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
+    """``skeleton`` with every joint ``depth_blind_joints`` names at ``pose`` a hinge about
+    the line of sight there (its axis in the joint's frame, its angle free): the paper's body
+    for one camera. ``skeleton`` itself when the views look different ways."""
+    blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose)]
+    if not blind:
+        return skeleton
+    frames = Kinematics(skeleton, pose).frames
+    kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
+    for j in blind:
+        kinds[j] = HINGE
+        axes[j] = frames[j, :3, :3].T @ pose.views[0].pose.R[2]
+        limits[j] = (-np.inf, np.inf)
+    out = Skeleton(skeleton.names, skeleton.parents, skeleton.offsets, kinds, axes,
+                   skeleton.end_sites, limits=limits)
+    out.blobs = skeleton.blobs
+    return out
 
 
 @dataclass
@@ -206,15 +230,23 @@ class Tracker:
             raise ValueError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
         if not skeleton.blobs:
             raise ValueError("the skeleton has no blobs: give its segments ellipsoids")
-        self.skeleton = skeleton
+        self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
         self._scales = Scales.unscaled(self.seq.n_views, self.settings)  # as seq is built
         self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
+        self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
+        self.notes: list[str] = []  # what the user should know about the run
+        self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
+        self._use(skeleton)
+
+    def _use(self, skeleton: Skeleton) -> None:
+        """Track ``skeleton``: its degrees of freedom and what depends on them."""
+        self.skeleton = skeleton
         self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
         self.n_dof = len(self._dof_joint)
-        self.n_params = n_root_params(mode, self.seq.n_views) + self.n_dof
+        self.n_params = n_root_params(self.mode, self.seq.n_views) + self.n_dof
         self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are now, stacked
         # thinnest blob each degree of freedom turns directly, world units (inf: none)
         thin = np.full(skeleton.n_joints, np.inf)
@@ -222,9 +254,6 @@ class Tracker:
         self.dof_thickness = thin[self._dof_joint]
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
-        self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
-        self.notes: list[str] = []  # what the user should know about the run
-        self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
         self._search = LimbSearch(skeleton, self.settings.limb_search)
 
     def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
@@ -652,12 +681,18 @@ class Tracker:
         key_frame, key = frames[0], initial
         self._key_sets.clear()  # the key pose may differ from an earlier run's
         self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it
-        blind = depth_blind_joints(self.skeleton, initial)
-        if blind:
+        blind = depth_blind_joints(self.given_skeleton, initial)
+        if self.settings.side_on:
+            self._use(side_on_skeleton(self.given_skeleton, initial))
+            if blind:
+                self.notes.append(f"side-on: {', '.join(blind)} tracked as hinges about the "
+                                  "line of sight, turning in the image plane only")
+        elif blind:
             self.notes.append(
                 f"every view looks along one line, so {', '.join(blind)} can turn toward or "
                 "away from the camera unseen (only foreshortening shows it): add a view from "
-                "another side, or track them as hinges about the line of sight")
+                "another side, or track side-on (the side_on setting: hinges about the line "
+                "of sight)")
         self._scale_to(initial)
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True, given=True)
         yield first

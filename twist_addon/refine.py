@@ -69,7 +69,7 @@ def refine_armature(scene, only_selected: bool, planar: bool, rounds: int,
         if tracker.mode != CALIBRATED:
             raise BridgeError("refining the skeleton needs calibrated views (Footage & Views "
                               "> Views: Calibrated)")
-        arm, sk = session.armature, tracker.skeleton
+        arm, sk = session.armature, tracker.given_skeleton
         start = sk.rest_positions if start is None else start
         names = [n for n, k in zip(sk.names[1:], sk.kinds[1:]) if k in (HINGE, BALL)
                  and (not only_selected or arm.pose.bones[n].select)]

@@ -95,7 +95,7 @@ class TrackSession:
 
     def run(self):
         """Yield after each frame is tracked and keyed."""
-        sk = self.tracker.skeleton
+        sk = self.tracker.given_skeleton  # the armature's joints, whatever side-on tracks
         steps = self.tracker.iter_track(self.initial, range(len(self.frames)),
                                         self.corrections)
         for res in steps:

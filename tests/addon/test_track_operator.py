@@ -103,6 +103,40 @@ def test_one_view_tracks_and_notes_the_joints_it_cannot_see_turn_in_depth(bpy_mo
     assert " ".join(lines) == notes[0]  # wrapped into the sidebar's lines, nothing lost
 
 
+def test_one_view_tracked_side_on_keys_turns_about_the_line_of_sight(bpy_module, registered,
+                                                                       footage):
+    """With Side On, one view's balls are tracked as hinges about the camera's line of
+    sight: every tracked bone's keyed turn from the first frame is about that line, and the
+    bones keep their own channels (quaternions)."""
+    bpy = bpy_module
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    tracking_scene(bpy, footage, VIEWS[:1], 4)
+    scene = bpy.context.scene
+    scene.twist.tracker.side_on = True
+    arm = scene.twist.armature
+    bridge = registered.twist_addon.bridge
+    sk = bridge.skeleton_from_armature(arm)
+    R0, p0 = bridge.pose_from_armature(arm, sk)
+    sight = np.array(scene.twist.views[0].camera.matrix_world.to_3x3())[:, 2]
+    world0 = sk.joint_frames(R0, p0)[:, :3, :3]
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    assert scene.twist.result.frames_tracked == 3  # frames 2-4
+    assert scene.twist.result.notes.startswith("side-on: ")
+    turned = 0
+    for f in range(2, 5):
+        scene.frame_set(f)
+        R, _ = bridge.pose_from_armature(arm, sk)
+        for bone in TRACKED:
+            j = sk.index(bone)
+            axis = world0[j].T @ sight  # the line of sight in the bone's frame at frame 1
+            w = se3.log_so3(R0[j].T @ R[j])
+            assert np.linalg.norm(np.cross(w, axis)) < 1e-4 * max(1, np.linalg.norm(w)), bone
+            turned += np.linalg.norm(w) > 0.01
+    assert turned > 5  # the bones did turn
+    keyed = _channel_frames(arm)
+    assert all(keyed[b] == {(f, "GENERATED") for f in range(2, 5)} for b in TRACKED)
+
+
 def _quaternions(addon, arm, bones, frame):
     """Each bone's quaternion keyed on ``frame``, and the types of those keys."""
     bag = addon.twist_addon.keyframes.channelbag(arm)

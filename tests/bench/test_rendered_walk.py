@@ -103,26 +103,3 @@ def test_zoomed_footage_is_the_same_stage_in_more_pixels(walk, tmp_path):
     for axis in (0, 1):
         for shift in (-1, 1):
             assert aligned < 0.8 * np.abs(np.roll(down, shift, axis) - small).mean()
-
-
-def test_side_on_hinges_keep_every_joint_at_its_depth_in_that_view(walk):
-    from walk_footage import side_on_hinges
-
-    from core import se3
-    from core.skeleton import skeleton_from_bvh
-
-    folder, _, info = walk
-    joints = side_on_hinges(folder, info["frames"][3], "lateral", info["cameras"])
-    truth = read_bvh(folder / "truth.bvh")
-    sk = skeleton_from_bvh(truth)
-    R, p = truth.frame_pose(3)
-    sight = np.array(info["cameras"]["lateral"]["R"])[2]
-    turned = R.copy()
-    rng = np.random.default_rng(0)
-    for name, spec in joints.items():  # every hinge turned by up to a radian either way
-        j = sk.index(name)
-        turned[j] = R[j] @ se3.exp_so3(np.array(spec["axis"]) * rng.uniform(-1, 1))
-    # each turn is about the line of sight, so the limbs move in the image plane only
-    moved = sk.world_positions(turned, p) - sk.world_positions(R, p)
-    assert np.abs(moved @ sight).max() < 1e-9
-    assert np.linalg.norm(moved, axis=1).max() > 0.1

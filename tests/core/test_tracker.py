@@ -14,6 +14,7 @@ from core.tracker import (
     TrackerSettings,
     _PointSet,
     depth_blind_joints,
+    side_on_skeleton,
     track,
 )
 from support.synthetic import render, side_view
@@ -347,6 +348,71 @@ def test_a_note_names_the_joints_that_turn_in_depth_when_the_views_share_a_line_
     assert len(notes) == 1 and all(n in notes[0] for n in names)
     three = [[render(sk, pose, c)] * 2 for c in range(3)]
     assert track(Tracker(sk, three, CALIBRATED), pose, [0, 1]).notes == []
+
+
+def test_side_on_joints_turn_in_the_image_plane_and_keep_every_joint_at_its_depth(body):
+    """One view from the front: every tracked joint could turn in depth, and side-on each
+    becomes a hinge about the line of sight (limits dropped); any turns then move joints in
+    the image only. Views from three sides leave the skeleton as it is."""
+    sk, pose = body
+    front = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=0)])
+    flat = side_on_skeleton(sk, front)
+    assert side_on_skeleton(sk, pose) is sk
+    names = sk.tracked_joint_names()
+    assert flat.tracked_joint_names() == names
+    assert all(flat.kinds[flat.index(n)] == HINGE for n in names)
+    sight = front.views[0].pose.R[2]
+    rng = np.random.default_rng(0)
+    turned = pose.rotations.copy()
+    for n in names:
+        j = flat.index(n)
+        assert np.all(np.isinf(flat.limits[j]))
+        turned[j] = pose.rotations[j] @ se3.exp_so3(flat.axes[j] * rng.uniform(-1, 1))
+    moved = (flat.world_positions(turned, pose.root_position)
+             - flat.world_positions(pose.rotations, pose.root_position))
+    assert np.abs(moved @ sight).max() < 1e-12 and np.linalg.norm(moved, axis=1).max() > 0.1
+
+
+def test_one_view_tracked_side_on_follows_the_limbs_in_the_image(body):
+    """Seen from the side, the hips and the neck turned in the image plane: side-on, the one
+    view's track puts every joint back on its image, and its note says how it tracked."""
+    sk, pose = body
+    side = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=90)])
+    flat = side_on_skeleton(sk, side)
+    moved = side.copy()
+    for name, angle in [("LeftHip", 0.3), ("Neck", 0.2)]:
+        j = flat.index(name)
+        moved.rotations[j] = moved.rotations[j] @ se3.exp_so3(flat.axes[j] * angle)
+    frames = [[render(sk, side, 0), render(sk, moved, 0, noise=0.01)]]
+    settings = TrackerSettings(side_on=True, iterations=10)
+    res = track(Tracker(sk, frames, CALIBRATED, settings), side, [0, 1])
+    est = res.frames[1].pose
+
+    def joint_pixels(p: BodyPose) -> np.ndarray:
+        return p.views[0].project(sk.world_positions(p.rotations, p.root_position))
+
+    assert np.abs(joint_pixels(moved) - joint_pixels(side)).max() > 15
+    assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 1.5  # measured 0.85
+    assert len(res.notes) == 1 and res.notes[0].startswith("side-on: ")
+    assert all(n in res.notes[0] for n in ["LeftShoulder", "RightHip", "Neck"])
+
+
+def test_one_view_keeps_the_root_where_it_was_along_its_line_of_sight(body):
+    """The root's translation along the one view's line of sight moves no pixel. With the
+    camera turned off the world's axes by rounding (1e-16), that unknown's column held only
+    rounding errors, and the step flung the root 1e5-1e11 metres along it."""
+    sk, pose = body
+    side = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=90)])
+    sight = side.views[0].pose.R[2]
+    assert 0 < abs(sight[2]) < 1e-12  # the rounding that exposed it
+    moved = side.copy()
+    j = sk.index("LeftHip")
+    moved.rotations[j] = moved.rotations[j] @ se3.exp_so3([0.2, 0.0, 0.0])
+    frames = [[render(sk, side, 0), render(sk, moved, 0, noise=0.01)]]
+    for silhouette in (0.0, 0.1):
+        res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(silhouette=silhouette)),
+                    side, [0, 1])
+        assert abs((res.frames[1].pose.root_position - side.root_position) @ sight) < 1e-3
 
 
 def test_a_correction_after_tracked_frames_starts_the_motion_afresh(body):
