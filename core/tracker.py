@@ -691,8 +691,8 @@ class Tracker:
             self.notes.append(
                 f"every view looks along one line, so {', '.join(blind)} can turn toward or "
                 "away from the camera unseen (only foreshortening shows it): add a view from "
-                "another side, or track side-on (the side_on setting: hinges about the line "
-                "of sight)")
+                "another side, or track side-on, as hinges about the line of sight (Side on "
+                "in the Track settings; side_on in a job)")
         self._scale_to(initial)
         first = FrameResult(key_frame, initial.copy(), 0.0, 0, True, given=True)
         yield first

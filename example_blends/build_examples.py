@@ -10,7 +10,7 @@ frames that were rendered are kept as walk_3view/truth.bvh.
 muybridge_horse.blend: Muybridge's "Sallie Gardner at a Gallop" plates behind one orthographic
 camera, and the planar quadruped template placed and scaled over the horse on plate 1;
 muybridge_woman.blend: a woman jumping, with the 19-degree-of-freedom human placed over her.
-Their limbs are left for the user to pose over the first plate.
+Their limbs are left for the user to pose over the first plate; both track side-on (one view).
 
 Paths are relative to each .blend, so the folder can move.
 """
@@ -87,6 +87,7 @@ def build_plates(bpy, name: str, plates: Path, template: str, ortho_scale: float
     bpy.ops.twist.add_template_armature(template=template)
     scene.twist.armature.rotation_euler[2] = np.radians(turn_deg)
     scene.twist.mode = "INDEPENDENT"
+    scene.twist.tracker.side_on = True  # one view of a body seen from the side
     scene.frame_start, scene.frame_end = 1, len(files)
     scene.render.fps = 15
     scene.camera = cam
