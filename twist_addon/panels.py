@@ -124,7 +124,7 @@ class TWIST_PT_results(_TwistPanel, bpy.types.Panel):
             layout.label(text="Stopped at frame " + result.diverged_frames, icon="ERROR")
         for note in result.notes.splitlines():
             col = layout.column(align=True)
-            for i, line in enumerate(textwrap.wrap(note, NOTE_WIDTH)):
+            for i, line in enumerate(textwrap.wrap(note, NOTE_WIDTH, break_on_hyphens=False)):
                 col.label(text=line, icon="INFO" if i == 0 else "BLANK1")
 
 
