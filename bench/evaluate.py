@@ -41,11 +41,17 @@ def _point(sk: Skeleton, frames: np.ndarray, name: str) -> np.ndarray:
     return M[:3, :3] @ sk.end_sites[sk.index(joint)][0] + M[:3, 3] if end else M[:3, 3]
 
 
+def limb_ends(sk: Skeleton, rotations, roots) -> dict[str, np.ndarray]:
+    """World positions (F, 3) of every limb end named in ``LIMBS``."""
+    frames = [sk.joint_frames(R, p) for R, p in zip(rotations, roots)]
+    names = {name for _, a, b in LIMBS for name in (a, b)}
+    return {name: np.array([_point(sk, M, name) for M in frames]) for name in sorted(names)}
+
+
 def limb_vectors(sk: Skeleton, rotations, roots) -> dict[str, np.ndarray]:
     """World direction vectors (F, 3) of each limb."""
-    frames = [sk.joint_frames(R, p) for R, p in zip(rotations, roots)]
-    return {label: np.array([_point(sk, M, b) - _point(sk, M, a) for M in frames])
-            for label, a, b in LIMBS}
+    ends = limb_ends(sk, rotations, roots)
+    return {label: ends[b] - ends[a] for label, a, b in LIMBS}
 
 
 @dataclass
@@ -86,13 +92,7 @@ def image_error_px(sk: Skeleton, est: tuple, truth: tuple, views: list) -> float
     as each of ``views`` (``core.camera.View``) shows them: how far the tracked body's
     overlay strays from the body in the footage, which even one view sees."""
     F = min(len(est[0]), len(truth[0]))
-    ends = sorted({name for _, a, b in LIMBS for name in (a, b)})
-
-    def points(poses):
-        frames = [sk.joint_frames(R, p) for R, p in zip(poses[0][:F], poses[1][:F])]
-        return np.array([[_point(sk, M, n) for n in ends] for M in frames]).reshape(-1, 3)
-
-    pe, pt = points(est), points(truth)
+    pe, pt = (np.concatenate(list(limb_ends(sk, R[:F], p[:F]).values())) for R, p in (est, truth))
     return float(np.mean([np.linalg.norm(v.project(pe) - v.project(pt), axis=1).mean()
                           for v in views]))
 
