@@ -148,13 +148,15 @@ def main(argv=None) -> int:
     settings = json.loads(a.settings)
 
     results, refs, steps, flat, image_px = {}, {}, {}, {}, {}
-    ref_of = {}  # run name -> its references' key in refs: (frame step, body)
+    # run name -> its references' key in refs: (frame step, first rendered frame, body)
+    ref_of = {}
     for name in a.runs.split(","):
         views, mode, step, joints = RUNS[name]
-        first = STARTS.get(name, 0)
-        frames = info["frames"][:: step // 4][first:]
+        # the run's frames among the rendered ones (30 fps), which truth.bvh holds too
+        sel = slice(STARTS.get(name, 0) * (step // 4), None, step // 4)
         job_path = write_job(a.cache, name.replace(" + ", "_").replace(" ", "_"), views, mode,
-                             frames, info["cameras"], settings | RUN_SETTINGS.get(name, {}),
+                             info["frames"][sel], info["cameras"],
+                             settings | RUN_SETTINGS.get(name, {}),
                              step / CAPTURE_FPS, joints, a.correct_every)
         out = job_path.with_suffix(".bvh")
         rep_path = job_path.with_suffix(".report.json")
@@ -166,7 +168,6 @@ def main(argv=None) -> int:
         job = load_job(job_path)
         sk = job.skeleton
         tracked_names = sk.tracked_joint_names()
-        sel = slice(first * step // 4, None, step // 4)
         truth = (truth_all[0][sel], truth_all[1][sel])
         est = read_bvh(out).poses()
         # corrected frames are the capture's own: scored are the frames tracked
@@ -179,8 +180,9 @@ def main(argv=None) -> int:
             job.cameras if mode == "calibrated" else job.cameras[:1])
         # the best fit of the joints tracked: side-on, those hinges about the line of sight
         fitted = side_on_skeleton(sk, job.initial) if job.settings.side_on else sk
-        ref_of[name] = step, first, ("best fit + spine" if joints is SPINE_JOINTS else
-                                     "best fit, side-on" if fitted is not sk else "best fit")
+        body = ("best fit + spine" if joints is SPINE_JOINTS
+                else "best fit, side-on" if fitted is not sk else "best fit")
+        ref_of[name] = step, sel.start, body
         if ref_of[name] not in refs:
             refs[ref_of[name]] = (
                 evaluate.score(sk, tracked_names, evaluate.held_still(truth), truth),
