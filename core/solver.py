@@ -103,7 +103,7 @@ def solve(
     # column of rounding errors (a root's translation along the line of sight of one view
     # that is not aligned with the world's axes): scaled up, it was flung 1e5-1e11 metres
     diag = d * (1 + damping) + pw
-    diag[diag <= UNSEEN * max(float(diag.max()), 0.0)] = 1.0
+    diag[diag <= UNSEEN * diag.max()] = 1.0
     S = 1 / np.sqrt(diag)
     M = (H - np.diag(d)) * S[:, None] * S[None, :] + np.eye(P)
     rhs = -(b + (pw * offset if offset is not None else 0.0)) * S
