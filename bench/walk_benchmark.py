@@ -9,10 +9,12 @@ Renders the footage once (bench/walk_footage.py, cached), writes one job per run
 error, the limb ends' distance from the truth in the footage, local-rotation error, frames
 tracked before any divergence and speed, beside references on the same frames: the first
 frame held still, the best fit that the tracked degrees of freedom allow to the true 3-D
-joints, and for one view the limbs read exactly in its image with nothing in depth (each
-true limb laid into the image plane). Each run tracks the paper's 19 degrees of freedom, or
-("+ spine") 22 with the lower back a ball too. With --correct-every N, every N-th frame is
-given the capture's pose as a user's correction, and the frames between are scored.
+joints, and for one view the limbs read in its image with nothing in depth (each true limb
+laid into the image plane) and lifted into depth by their lengths, the depth signs guessed
+by the steadiest motion (with their ends read exactly, and 1 and 2 pixels off). Each run
+tracks the paper's 19 degrees of freedom, or ("+ spine") 22 with the lower back a ball too.
+With --correct-every N, every N-th frame is given the capture's pose as a user's correction,
+and the frames between are scored.
 """
 
 from __future__ import annotations
@@ -55,6 +57,10 @@ WALK_RUN = "1 lateral view 15 fps on the walk"
 SIDE_ON_RUN = "1 lateral view 15 fps side-on on the walk"
 STARTS = {WALK_RUN: 24, SIDE_ON_RUN: 24}  # a run's first frame, in its own frames (else 0)
 RUN_SETTINGS = {SIDE_ON_RUN: {"side_on": True}}  # over --settings
+# one view's limbs lifted into depth by their lengths (evaluate.lifted_from_the_image) with
+# their ends read exactly and this many pixels off, the mean of LIFT_DRAWS draws of the noise
+LIFT_PIXELS = (0, 1, 2)
+LIFT_DRAWS = 8
 # name: (views, mode, capture frames per video frame: 4 = 30 fps, 8 = 15 fps, tracked joints)
 RUNS = {
     "3 views calibrated 15 fps": (THREE, "calibrated", 8, JOINTS),
@@ -147,7 +153,7 @@ def main(argv=None) -> int:
     truth_all = truth_bvh.poses()
     settings = json.loads(a.settings)
 
-    results, refs, steps, flat, image_px = {}, {}, {}, {}, {}
+    results, refs, steps, flat, lifted, image_px = {}, {}, {}, {}, {}, {}
     # run name -> its references' key in refs: (frame step, first rendered frame, body)
     ref_of = {}
     for name in a.runs.split(","):
@@ -188,9 +194,14 @@ def main(argv=None) -> int:
                 evaluate.score(sk, tracked_names, evaluate.held_still(truth), truth),
                 evaluate.score(sk, tracked_names, evaluate.best_fit(fitted, truth), truth),
             )
-        if len(views) == 1:  # what that view shows without depth
-            sight = np.array(info["cameras"][views[0]]["R"])[2]
+        if len(views) == 1:  # what that view shows without depth, and with it from lengths
+            camera = info["cameras"][views[0]]
+            sight = np.array(camera["R"])[2]
             flat[name] = evaluate.in_the_image_plane(sk, truth, sight)["mean"]
+            lift = evaluate.lifted_from_the_image
+            lifted[name] = [np.mean([
+                lift(sk, truth, sight, px / camera["scale"], seed)["mean"]
+                for seed in range(LIFT_DRAWS if px else 1)]) for px in LIFT_PIXELS]
         if mode == "calibrated" and not job.settings.side_on:  # (no true pose to start from)
             steps[name] = one_step(job_path, truth)
             steps[name + ", at the truth"] = one_step(job_path, truth, at_truth=True)
@@ -200,9 +211,10 @@ def main(argv=None) -> int:
 
     print()
     print("| run | frames tracked | limb dir. err (8 limbs) | neck-head | joint pos. err |"
-          " image err | held still | best fit | image plane only | tracking fps |"
+          " image err | held still | best fit | image plane only | lifted by lengths"
+          f" ({' / '.join(f'{px} px' for px in LIFT_PIXELS)}) | tracking fps |"
           " s / iteration | peak memory |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, (s, rep) in results.items():
         still, best = refs[ref_of[name]]
         first_div = rep["diverged_frames"][0] if rep["diverged_frames"] else None
@@ -212,6 +224,8 @@ def main(argv=None) -> int:
               f" {s.position_mm:.0f} mm | {image_px[name]:.1f} px | {still.limb_mean_deg:.1f}° |"
               f" {best.limb_mean_deg:.1f}° |"
               f" {fmt(flat.get(name))}{'°' if name in flat else ''} |"
+              f" {' / '.join(fmt(x) for x in lifted.get(name, [None]))}"
+              f"{'°' if name in lifted else ''} |"
               f" {fmt(rep['frames_per_second'])} | {fmt(rep['seconds_per_iteration'], 3)} |"
               f" {rep['peak_mb']:.0f} MB |")
     print()

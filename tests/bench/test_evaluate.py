@@ -49,3 +49,40 @@ def test_the_image_error_is_how_far_each_view_sees_the_limb_ends_moved(cmu_walk)
     assert evaluate.image_error_px(sk, moved, truth, [side]) < 1e-9
     assert abs(evaluate.image_error_px(sk, moved, truth, [front]) - 3.0) < 1e-9
     assert abs(evaluate.image_error_px(sk, moved, truth, [side, front]) - 1.5) < 1e-9
+
+
+def _thigh_swung_about_x(cmu_walk, degrees):
+    """The rest pose with the left thigh turned about world x by each angle: seen along z,
+    the thigh tilts out of the image plane by the angle, and back."""
+    b = read_bvh(cmu_walk)
+    sk = skeleton_from_bvh(b)
+    R, p = b.frame_pose(0)
+    R[:] = np.eye(3)  # the capture's thighs lie in the x-y plane here
+    Rs = np.repeat(R[None], len(degrees), axis=0)
+    for f, a in enumerate(degrees):
+        Rs[f, sk.index("LeftHip")] = se3.exp_so3([np.radians(a), 0.0, 0.0])
+    return sk, (Rs, np.repeat(p[None], len(degrees), axis=0))
+
+
+def test_a_limb_lifted_from_one_image_has_its_depth_from_its_length(cmu_walk):
+    # swung through the image plane at a steady rate: its length gives each frame's depth,
+    # and going on through the plane is the steadier of the two paths the image allows
+    sk, truth = _thigh_swung_about_x(cmu_walk, [25, 15, 5, -5, -15, -25])
+    lifted = evaluate.lifted_from_the_image(sk, truth, [0, 0, 1])
+    flat = evaluate.in_the_image_plane(sk, truth, [0, 0, 1])
+    assert lifted["left thigh"] < 1e-6
+    assert flat["left thigh"] > 5
+
+
+def test_a_limb_turning_back_at_the_image_plane_is_lifted_as_its_mirror_image(cmu_walk):
+    # out to the plane and back on the same side: every frame's image is the one above, so
+    # the lift is too, and the frames after the turn read the mirror image, off by the angle
+    # between the two
+    sk, truth = _thigh_swung_about_x(cmu_walk, [25, 15, 5, 5, 15, 25])
+    lifted = evaluate.lifted_from_the_image(sk, truth, [0, 0, 1])
+    v = evaluate.limb_vectors(sk, *truth)["left thigh"]
+    mirrored = v * [1.0, 1.0, -1.0]
+    expected = np.degrees(se3.angle_between_vectors(v[3:], mirrored[3:])).sum() / len(v)
+    assert expected > 5
+    assert abs(lifted["left thigh"] - expected) < 1e-6
+
