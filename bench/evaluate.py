@@ -117,8 +117,14 @@ def _steadiest_signs(flat: np.ndarray, depth: np.ndarray, first: float) -> np.nd
     between the two mirror images of each frame (Viterbi over the signs of two frames;
     ``sight`` is any unit vector orthogonal to ``flat``, so it is not needed)."""
     signs = np.array([-1.0, 1.0])
-    # cost[a, b]: the steadiest path whose frames f-1 and f have signs a and b
-    cost = np.where(signs[:, None] == first, 0.0, np.inf) + np.zeros((1, 2))
+    # cost[a, b]: the steadiest path whose frames f-1 and f have signs a and b; the limb at
+    # rest before the first frame (as the tracker starts), so the first step counts whole
+    cost = np.full((2, 2), np.inf)
+    if len(depth) > 1:
+        cost[signs == first] = np.hypot(np.linalg.norm(flat[1] - flat[0]),
+                                        signs * depth[1] - first * depth[0])
+    else:
+        cost[signs == first] = 0.0
     back = []
     for f in range(2, len(depth)):
         bend = np.linalg.norm(flat[f] - 2 * flat[f - 1] + flat[f - 2])
@@ -140,7 +146,7 @@ def lifted_from_the_image(sk: Skeleton, truth: tuple, sight: np.ndarray, noise: 
     along ``sight`` (a world direction) and lifted into depth as that view allows: each
     limb's depth from its known length (its image shortens by its tilt), its sign (toward
     or away from the camera, which an orthographic image does not show) the first frame's
-    and then the steadiest path's. With ``noise`` (world units; pixels over the view's
+    and then the steadiest path's from rest. With ``noise`` (world units; pixels over the view's
     scale) every limb end is read that far off in the image, at random (normal, per image
     axis). With no noise: what a one-view tracker that guesses depth signs from motion alone
     gets from perfect pixels."""

@@ -86,3 +86,10 @@ def test_a_limb_turning_back_at_the_image_plane_is_lifted_as_its_mirror_image(cm
     assert expected > 5
     assert abs(lifted["left thigh"] - expected) < 1e-6
 
+
+
+def test_a_limb_lifted_over_two_frames_starts_from_rest(cmu_walk):
+    # no second frame to steady the path by: the limb is taken at rest before the first
+    # frame, so the second keeps the first one's side of the image plane
+    sk, truth = _thigh_swung_about_x(cmu_walk, [-25, -15])
+    assert evaluate.lifted_from_the_image(sk, truth, [0, 0, 1])["left thigh"] < 1e-6
