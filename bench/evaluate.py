@@ -97,17 +97,28 @@ def image_error_px(sk: Skeleton, est: tuple, truth: tuple, views: list) -> float
                           for v in views]))
 
 
+def _across(v: np.ndarray, sight: np.ndarray) -> np.ndarray:
+    """Vectors (F, 3) with their parts along the unit ``sight`` taken out: laid into the
+    image plane of a view looking along it."""
+    return v - np.outer(v @ sight, sight)
+
+
+def _read_errors(truth: dict[str, np.ndarray], read: dict[str, np.ndarray]) -> dict[str, float]:
+    """Mean angle (degrees) between each limb's true and read direction vectors (F, 3) over
+    the frames, and ``"mean"``, over the eight limb bones."""
+    per = {k: np.degrees(se3.angle_between_vectors(truth[k], read[k])) for k in read}
+    out = {k: float(v.mean()) for k, v in per.items()}
+    out["mean"] = float(np.mean([per[k] for k in HEADLINE]))
+    return out
+
+
 def in_the_image_plane(sk: Skeleton, truth: tuple, sight: np.ndarray) -> dict[str, float]:
     """Mean limb-direction error (degrees) of limbs read exactly in the image of one view
     looking along ``sight`` (a world direction) with nothing read in depth: each true limb
     laid into the image plane. What a single view leaves to be inferred about depth."""
     vt = limb_vectors(sk, *truth)
     sight = np.asarray(sight, dtype=float) / np.linalg.norm(sight)
-    per = {k: np.degrees(se3.angle_between_vectors(v, v - np.outer(v @ sight, sight)))
-           for k, v in vt.items()}
-    out = {k: float(v.mean()) for k, v in per.items()}
-    out["mean"] = float(np.mean([per[k] for k in HEADLINE]))
-    return out
+    return _read_errors(vt, {k: _across(v, sight) for k, v in vt.items()})
 
 
 def _steadiest_signs(flat: np.ndarray, depth: np.ndarray, first: float) -> np.ndarray:
@@ -116,15 +127,14 @@ def _steadiest_signs(flat: np.ndarray, depth: np.ndarray, first: float) -> np.nd
     difference, the constant-velocity prediction's measure), the first sign given: a choice
     between the two mirror images of each frame (Viterbi over the signs of two frames;
     ``sight`` is any unit vector orthogonal to ``flat``, so it is not needed)."""
+    if len(depth) < 2:
+        return np.full(len(depth), first)
     signs = np.array([-1.0, 1.0])
     # cost[a, b]: the steadiest path whose frames f-1 and f have signs a and b; the limb at
     # rest before the first frame (as the tracker starts), so the first step counts whole
     cost = np.full((2, 2), np.inf)
-    if len(depth) > 1:
-        cost[signs == first] = np.hypot(np.linalg.norm(flat[1] - flat[0]),
-                                        signs * depth[1] - first * depth[0])
-    else:
-        cost[signs == first] = 0.0
+    cost[signs == first] = np.hypot(np.linalg.norm(flat[1] - flat[0]),
+                                    signs * depth[1] - first * depth[0])
     back = []
     for f in range(2, len(depth)):
         bend = np.linalg.norm(flat[f] - 2 * flat[f - 1] + flat[f - 2])
@@ -137,7 +147,7 @@ def _steadiest_signs(flat: np.ndarray, depth: np.ndarray, first: float) -> np.nd
     path = [int(c), int(b)]
     for best_a in reversed(back):
         path.append(int(best_a[path[-1], path[-2]]))
-    return signs[path[::-1][:len(depth)]]
+    return signs[path[::-1]]
 
 
 def lifted_from_the_image(sk: Skeleton, truth: tuple, sight: np.ndarray, noise: float = 0.0,
@@ -153,22 +163,16 @@ def lifted_from_the_image(sk: Skeleton, truth: tuple, sight: np.ndarray, noise: 
     sight = np.asarray(sight, dtype=float) / np.linalg.norm(sight)
     rng = np.random.default_rng(seed)
     ends = limb_ends(sk, *truth)
-    seen = {}
-    for name, e in ends.items():
-        off = rng.normal(0.0, noise, e.shape)
-        seen[name] = e + off - np.outer(off @ sight, sight)  # read off in the image only
-    per = {}
+    # each end read off at random (its part along the sight goes with the depth below)
+    seen = {name: e + rng.normal(0.0, noise, e.shape) for name, e in ends.items()}
+    true, read = {}, {}
     for label, a, b in LIMBS:
-        v = ends[b] - ends[a]
-        w = seen[b] - seen[a]
-        flat = w - np.outer(w @ sight, sight)
+        v = true[label] = ends[b] - ends[a]
+        flat = _across(seen[b] - seen[a], sight)
         depth = np.sqrt(np.maximum(np.sum(v * v, axis=1) - np.sum(flat * flat, axis=1), 0.0))
         signs = _steadiest_signs(flat, depth, 1.0 if v[0] @ sight >= 0 else -1.0)
-        per[label] = np.degrees(se3.angle_between_vectors(v, flat + np.outer(signs * depth,
-                                                                                sight)))
-    out = {k: float(v.mean()) for k, v in per.items()}
-    out["mean"] = float(np.mean([per[k] for k in HEADLINE]))
-    return out
+        read[label] = flat + np.outer(signs * depth, sight)
+    return _read_errors(true, read)
 
 
 def held_still(truth: tuple) -> tuple:
