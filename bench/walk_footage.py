@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 from core.bvh import read_bvh, write_bvh  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
-CMU_WALK = ROOT.parent / "shared" / "data" / "mocap" / "cmu_131_01_walk.bvh"
+CMU_WALK = ROOT / "bench" / "data" / "cmu_131_01_walk.bvh"  # see SOURCES.md there
 WIDTH, HEIGHT = 480, 360
 PIXELS_PER_METRE = 150.0
 STAGE_CENTRE = np.array([0.5, 0.85, -0.55])  # world point at the middle of every image

@@ -63,19 +63,12 @@ def build_walk(bpy) -> Path:
     return path
 
 
-MUYBRIDGE = ROOT.parent / "shared" / "data" / "muybridge"
-
-
-def build_plates(bpy, name: str, plates: Path, template: str, ortho_scale: float,
-                 location: tuple, turn_deg: float = 0.0) -> Path:
-    """One view of Muybridge plates with a template armature placed over the subject."""
+def build_plates(bpy, name: str, template: str, ortho_scale: float, location: tuple,
+                 turn_deg: float = 0.0) -> Path:
+    """One view of the Muybridge plates in ``example_blends/NAME/`` (see SOURCES.md) with a
+    template armature placed over the subject."""
     out = HERE / name
-    if out.exists():
-        shutil.rmtree(out)
-    out.mkdir()
-    files = sorted(plates.glob("*.png"))
-    for p in files:
-        shutil.copy(p, out / p.name)
+    files = sorted(out.glob("*.png"))
     bpy.ops.wm.read_factory_settings(use_empty=True)
     path = HERE / f"{name}.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
@@ -103,12 +96,11 @@ def main() -> int:
     print(build_walk(bpy))
     # the horse: the quadruped's trunk along the barrel (rump at (88, 92)), its poll near the
     # ears, 70 px per metre across the 300 x 200 plates
-    print(build_plates(bpy, "muybridge_horse", MUYBRIDGE / "horse_gallop", "QUADRUPED",
-                       300 / 70.2, (0.076, -10.0, 1.193)))
+    print(build_plates(bpy, "muybridge_horse", "QUADRUPED", 300 / 70.2, (0.076, -10.0, 1.193)))
     # the woman (facing right): hips near (85, 193) and feet on the plate's bottom, 160 px per
     # metre down the 185 x 375 plates; the human turned to face the image's right
-    print(build_plates(bpy, "muybridge_woman", MUYBRIDGE / "woman_jumping", "HUMAN",
-                       375 / 160, (0.044, -10.0, 0.9875), turn_deg=90))
+    print(build_plates(bpy, "muybridge_woman", "HUMAN", 375 / 160, (0.044, -10.0, 0.9875),
+                       turn_deg=90))
     return 0
 
 
