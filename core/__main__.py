@@ -16,7 +16,8 @@ import sys
 from .bvh import write_bvh
 from .image import ImageError
 from .init_fit import FitError, fit_pose, least_certain
-from .job import JobError, load_fit, load_job, world_root
+from .job import JobError, load_fit, load_job
+from .pose import world_pose
 from .run import report, result_bvh, timed_run, write_report
 
 
@@ -61,8 +62,7 @@ def _fit(args) -> int:
     except (JobError, FitError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    R = res.pose.rotations.copy()
-    R[0], root = world_root(job.mode, job.cameras[0], res.pose)
+    R, root = world_pose(job.mode, job.cameras[0], res.pose)
     out = job.bvh.with_motion(R[None], root[None])
     out.joints = [dataclasses.replace(j, offset=o) for j, o in zip(out.joints,
                                                                    res.skeleton.offsets)]

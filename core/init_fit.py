@@ -1,11 +1,11 @@
 """The first frame's pose, and the body's proportions, from joints clicked in each view.
 
 Unknowns: the root's pose (one world pose when the cameras are calibrated; otherwise each view's
-scale, rotation and image translation, paper section 2.6), every tracked joint's rotation
-(balls as rotation vectors, hinges as angles) and one length factor per bone, shared by the
-left and right bones of a pair and by bones in line that meet at no click. Residuals: each
-clicked joint's projection minus its click, in pixels, with a robust (soft-L1) loss, plus
-weak priors that keep unconstrained unknowns at the guess. Solved by
+scale, rotation and image translation, paper section 2.6) and every tracked joint's rotation,
+both stepped as the tracker steps them (``core.pose.apply_update``), and one length factor per
+bone, shared by the left and right bones of a pair and by bones in line that meet at no
+click. Residuals: each clicked joint's projection minus its click, in pixels, with a robust
+(soft-L1) loss, plus weak priors that keep unconstrained unknowns at the guess. Solved by
 ``scipy.optimize.least_squares`` with length factors bounded to [0.5, 2].
 
 How precisely the clicks pin the result: the fit's information matrix J^T J at the solution
@@ -22,16 +22,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from . import se3
-from .camera import View
-from .pose import CALIBRATED, BodyPose
-from .skeleton import BALL, HINGE, Skeleton
+from .errors import InputError
+from .pose import CALIBRATED, BodyPose, apply_update, n_root_params
+from .skeleton import BALL, Skeleton
 
 PRIOR_ANGLE = 0.02  # weight (pixels per radian) holding unconstrained rotations at the guess
 PRIOR_LENGTH = 0.5  # weight (pixels per unit of log length) holding lengths at the guess
 
 
-class FitError(ValueError):
+class FitError(InputError):
     """Clicks that cannot determine a pose; the message says what to add."""
 
 
@@ -98,7 +97,7 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     bones = [j for j in range(1, sk.n_joints) if np.linalg.norm(sk.offsets[j]) > 1e-9]
     groups = sorted({group_key(j) for j in bones})
     group_of = [groups.index(group_key(j)) if j in bones else -1 for j in range(sk.n_joints)]
-    n_root = 6 if mode == CALIBRATED else 6 * len(guess.views)
+    n_root = n_root_params(mode, len(guess.views))
     n_dof = len(dof_joint)
     n_len = len(groups) if fit_lengths else 0
     # what clicked joint positions can pin down: the root, and per joint with a clicked joint
@@ -113,33 +112,11 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
                        "joints in a second view")
 
     def unpack(x):
-        R = guess.rotations.copy()
-        k = n_root
-        for j in joints:
-            if sk.kinds[j] == BALL:
-                R[j] = guess.rotations[j] @ se3.exp_so3(x[k:k + 3])
-                k += 3
-            elif sk.kinds[j] == HINGE:
-                R[j] = guess.rotations[j] @ se3.exp_so3(sk.axes[j] * x[k])
-                k += 1
+        pose = apply_update(sk, guess, x[:n_root + n_dof], mode)
         factors = np.exp(x[n_root + n_dof:]) if fit_lengths else np.ones(0)
         scale = np.array([factors[g] if g >= 0 and fit_lengths else 1.0 for g in group_of])
-        offsets = sk.offsets * scale[:, None]
-        views = []
-        if mode == CALIBRATED:
-            R[0] = se3.exp_so3(x[3:6]) @ guess.rotations[0]
-            root = guess.root_position + x[:3]
-            views = guess.views
-        else:
-            root = guess.root_position
-            for c, v in enumerate(guess.views):
-                ds, t1, t2, w = x[6 * c], x[6 * c + 1], x[6 * c + 2], x[6 * c + 3:6 * c + 6]
-                E = se3.exp_so3(w)
-                P = v.pose
-                s = P.s * np.exp(ds)
-                views.append(View(se3.Similarity(s, E @ P.R, E @ P.t + np.array(
-                    [t1, t2, 0.0]) / s), v.center))
-        return R, root, offsets, views, factors
+        return pose.rotations, pose.root_position, sk.offsets * scale[:, None], pose.views, \
+            factors
 
     # per view, the clicked joints and their clicks (n, 2)
     clicked_at = [(np.array([sk.index(n) for n in v], dtype=int),

@@ -44,14 +44,15 @@ import numpy as np
 from . import se3
 from .bvh import BvhError, BvhFile, read_bvh
 from .camera import View
+from .errors import InputError
 from .image import ImageError
-from .pose import CALIBRATED, INDEPENDENT, BodyPose
+from .pose import CALIBRATED, INDEPENDENT, BodyPose, pose_from_bvh
 from .skeleton import BALL, FIXED, HINGE, Skeleton, skeleton_from_bvh
 from .tracker import TrackerSettings
 from .video import VideoFrames, is_video
 
 
-class JobError(ValueError):
+class JobError(InputError):
     """A job that cannot run; the message names the field and what is expected."""
 
 
@@ -213,11 +214,6 @@ def _settings(spec, where: str) -> TrackerSettings:
         raise JobError(f"{where}: {e}") from None
 
 
-def initial_pose(sk: Skeleton, bvh: BvhFile, frame: int, cameras: list[View]) -> BodyPose:
-    R, root = bvh.frame_pose(frame)
-    return BodyPose(R, root, [c.copy() for c in cameras])
-
-
 def _read_json(path: Path, what: str) -> dict:
     try:
         d = json.loads(path.read_text())
@@ -283,7 +279,7 @@ def _corrections(spec, sk: Skeleton, bvh: BvhFile, bvh_path: Path, base: Path,
         if image in out:
             raise JobError(f"{at}.image: frame {image} is corrected twice")
         pose_bvh, frame = _bvh_pose(c, bvh, bvh_path, base, at)
-        out[image] = initial_pose(sk, pose_bvh, frame, cameras)
+        out[image] = pose_from_bvh(pose_bvh, frame, cameras)
     return out
 
 
@@ -324,7 +320,7 @@ def load_job(path: str | Path) -> Job:
     ft = d.get("frame_time", bvh.frame_time)
     if not isinstance(ft, (int, float)) or ft <= 0:
         raise JobError(f"{where}.frame_time: expected seconds per frame > 0, got {ft!r}")
-    pose = initial_pose(sk, init_bvh, frame, cameras)
+    pose = pose_from_bvh(init_bvh, frame, cameras)
     corrections = _corrections(d.get("corrections", []), sk, bvh, bvh_path, base, cameras,
                                len(images[0]), f"{where}.corrections")
     return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections)
@@ -367,17 +363,5 @@ def load_fit(path: str | Path) -> FitJob:
                 raise JobError(f"{w}.{name}: no such joint in the BVH")
         clicks.append({name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()})
     fit_lengths = _field(d, "fit_lengths", where, bool) if "fit_lengths" in d else True
-    return FitJob(sk, bvh, initial_pose(sk, init_bvh, frame, cameras), cameras, clicks,
+    return FitJob(sk, bvh, pose_from_bvh(init_bvh, frame, cameras), cameras, clicks,
                   _mode(d, where), fit_lengths)
-
-
-def world_root(mode: str, first_camera: View, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:
-    """Root world rotation (3, 3) and position (3,) of a tracked pose. In independent mode the
-    root is read through the first view: its given camera undoes that view's tracked pose."""
-    if mode == CALIBRATED:
-        return pose.rotations[0], pose.root_position
-    cam, eff = first_camera.pose, pose.views[0].pose
-    R = cam.R.T @ eff.R @ pose.rotations[0]
-    q = eff.apply(pose.root_position)
-    p = cam.R.T @ (q / cam.s - cam.t)
-    return R, p

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import se3
+from .bvh import BvhFile
 from .camera import View
 from .skeleton import Skeleton
 
@@ -40,6 +41,12 @@ class BodyPose:
         return BodyPose(
             self.rotations.copy(), self.root_position.copy(), [v.copy() for v in self.views]
         )
+
+
+def pose_from_bvh(bvh: BvhFile, frame: int, cameras: list[View]) -> BodyPose:
+    """The pose of a BVH file's frame (0-based), seen through copies of ``cameras``."""
+    R, root = bvh.frame_pose(frame)
+    return BodyPose(R, root, [c.copy() for c in cameras])
 
 
 def n_root_params(mode: str, n_views: int) -> int:
@@ -94,3 +101,17 @@ def extrapolate(prev: BodyPose, cur: BodyPose, gain: float = 1.0) -> BodyPose:
         sn = np.cbrt(np.linalg.det(M[:3, :3]))
         out.views[c] = View(se3.Similarity(sn, M[:3, :3] / sn, M[:3, 3] / sn), vc.center.copy())
     return out
+
+
+def world_pose(mode: str, first_camera: View, pose: BodyPose) -> tuple[np.ndarray, np.ndarray]:
+    """The joints' local rotations (J, 3, 3), the root's among them in the world, and the
+    root's world position (3,) of a tracked pose: what keyframes and BVH files hold. In
+    independent mode the root is read through the first view: its given camera
+    ``first_camera`` undoes that view's tracked pose."""
+    R = pose.rotations.copy()
+    if mode == CALIBRATED:
+        return R, pose.root_position.copy()
+    cam, eff = first_camera.pose, pose.views[0].pose
+    R[0] = cam.R.T @ eff.R @ pose.rotations[0]
+    q = eff.apply(pose.root_position)
+    return R, cam.R.T @ (q / cam.s - cam.t)

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .job import Job, world_root
+from .job import Job
+from .pose import world_pose
 from .tracker import FrameResult, Tracker, TrackResult, track
 
 
@@ -29,9 +30,7 @@ def result_bvh(job: Job, result: TrackResult):
     """The job's BVH hierarchy holding one frame per tracked frame."""
     rots, roots = [], []
     for fr in result.frames:
-        R0, p0 = world_root(job.mode, job.cameras[0], fr.pose)
-        R = fr.pose.rotations.copy()
-        R[0] = R0
+        R, p0 = world_pose(job.mode, job.cameras[0], fr.pose)
         rots.append(R)
         roots.append(p0)
     out = job.bvh.with_motion(np.array(rots), np.array(roots))

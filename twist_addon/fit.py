@@ -15,8 +15,8 @@ import bpy
 import numpy as np
 
 from ..core.init_fit import FitError, fit_pose, least_certain
-from ..core.job import world_root
-from ..core.pose import BodyPose
+from ..core.pose import BodyPose, world_pose
+from .armature_action import ArmatureAction
 from .bridge import (
     BridgeError,
     pose_from_armature,
@@ -25,7 +25,6 @@ from .bridge import (
     view_from_camera,
 )
 from .markers import markers_at, set_marker
-from .reporting import ArmatureAction
 
 
 def read_markers_csv(path: Path, scene) -> int:
@@ -110,8 +109,7 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
     if changed:
         scale_bones(arm, changed)
         sk = skeleton_from_armature(arm)
-    R_fit = res.pose.rotations.copy()
-    R_fit[0], root_fit = world_root(mode, views[0], res.pose)
+    R_fit, root_fit = world_pose(mode, views[0], res.pose)
     set_pose(arm, sk, R_fit, root_fit)
     return res.residual_px, changed, least_certain(res.direction_uncertainty)
 
