@@ -16,11 +16,13 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .errors import InputError
+
 _ROT = ("Xrotation", "Yrotation", "Zrotation")
 _POS = ("Xposition", "Yposition", "Zposition")
 
 
-class BvhError(ValueError):
+class BvhError(InputError):
     """A BVH file that cannot be read; the message names the file and the line."""
 
 

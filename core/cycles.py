@@ -12,6 +12,11 @@ from collections.abc import Callable
 import numpy as np
 from scipy.signal import butter, filtfilt
 
+from .errors import InputError
+
+
+class CycleError(InputError):
+    """Curves that hold no usable cycle, or settings that do not fit them."""
 
 def gait_period(curves: np.ndarray, min_frames: int = 4) -> float:
     """Period in frames (sub-frame) of the repetition in ``curves`` (F, C): the first peak of
@@ -22,10 +27,10 @@ def gait_period(curves: np.ndarray, min_frames: int = 4) -> float:
     F = len(x)
     ac = np.array([np.mean(x[: F - k] * x[k:]) for k in range(F // 2)])
     below = np.flatnonzero(ac < 0)
-    if not len(below):
-        raise ValueError("the curves do not repeat within half their length")
-    start = max(int(below[0]), min_frames)
+    start = max(int(below[0]), min_frames) if len(below) else len(ac)
     tail = ac[start:]
+    if not len(tail):
+        raise CycleError(f"the curves do not repeat within half their length ({F} frames)")
     peaks = [i for i in range(1, len(tail) - 1)
              if tail[i - 1] <= tail[i] >= tail[i + 1] and tail[i] >= 0.8 * tail.max()]
     k = start + (peaks[0] if peaks else int(np.argmax(tail)))
@@ -55,7 +60,7 @@ def complete_by_mirroring(curves: np.ndarray, period: float,
     half = period / 2
     F = len(curves)
     if F < half:
-        raise ValueError(f"{F} frames are less than half a period ({half:.1f} frames)")
+        raise CycleError(f"{F} frames are less than half a period ({half:.1f} frames)")
     t = np.arange(F, int(round(period)), dtype=float)
     recorded = np.asarray(curves, float)[: int(round(period))]
     if not len(t):
@@ -96,7 +101,7 @@ def make_loop(cycle: np.ndarray, blend: int) -> np.ndarray:
     x = np.asarray(cycle, float).copy()
     F = len(x)
     if not 1 <= blend < F - 2:
-        raise ValueError(f"blend must be between 1 and {F - 3} frames")
+        raise CycleError(f"blend must be between 1 and {F - 3} frames")
     a = F - blend - 1
     p0, m0 = x[a], x[a] - x[a - 1]
     p1, m1 = x[0], x[1] - x[0]
@@ -110,7 +115,7 @@ def make_loop(cycle: np.ndarray, blend: int) -> np.ndarray:
 def lowpass(curves: np.ndarray, cutoff_hz: float, fps: float) -> np.ndarray:
     """Zero-phase Butterworth low-pass (second order, run forward and back) of curves (F, C)."""
     if not 0 < cutoff_hz < fps / 2:
-        raise ValueError(f"the cutoff must be between 0 and {fps / 2} Hz (half the frame rate)")
+        raise CycleError(f"the cutoff must be between 0 and {fps / 2} Hz (half the frame rate)")
     b, a = butter(2, cutoff_hz / (fps / 2))
     return filtfilt(b, a, np.asarray(curves, float), axis=0,
                     padlen=min(len(curves) - 1, 3 * max(len(a), len(b))))

@@ -15,11 +15,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .errors import InputError
+
 # cv2.remap takes maps of at most 32767 columns
 _REMAP_COLS = 16384
 
 
-class ImageError(ValueError):
+class ImageError(InputError):
     """An image that cannot be read; the message names the file."""
 
 

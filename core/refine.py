@@ -31,6 +31,7 @@ from scipy.optimize import least_squares
 
 from . import se3
 from .blas import one_blas_thread
+from .errors import InputError
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, BodyPose
 from .skeleton import BALL, HINGE, Skeleton
@@ -42,7 +43,7 @@ SETTLED_SHIFT = 1e-3  # world units: a round that moves no joint more is settled
 SETTLED_TURN = 0.5  # ... if it turns no hinge's axis more degrees either
 
 
-class RefineError(ValueError):
+class RefineError(InputError):
     """A refinement that cannot be made; the message says why."""
 
 

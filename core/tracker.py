@@ -32,6 +32,7 @@ from . import image as imagelib
 from . import raycast, se3
 from . import silhouette as sil
 from .blas import one_blas_thread
+from .errors import InputError
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from .scales import REFERENCE_BODY_PIXELS, Scales
@@ -112,7 +113,7 @@ class TrackerSettings:
     def __post_init__(self):
         for name in ("levels", "iterations", "pixel_step"):
             if int(getattr(self, name)) < 1:
-                raise ValueError(f"settings.{name} must be a whole number >= 1")
+                raise InputError(f"settings.{name} must be a whole number >= 1")
 
 
 def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
@@ -227,9 +228,9 @@ class Tracker:
         settings: TrackerSettings | None = None,
     ):
         if mode not in (CALIBRATED, INDEPENDENT):
-            raise ValueError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
+            raise InputError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
         if not skeleton.blobs:
-            raise ValueError("the skeleton has no blobs: give its segments ellipsoids")
+            raise InputError("the skeleton has no blobs: give its segments ellipsoids")
         self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
         self.mode = mode
         self.settings = settings or TrackerSettings()
@@ -675,7 +676,7 @@ class Tracker:
             if not 0 <= f < n:
                 raise IndexError(f"frame {f} is outside the footage's 0..{n - 1}")
         if len(initial.views) != self.seq.n_views:
-            raise ValueError(
+            raise InputError(
                 f"the pose has {len(initial.views)} views, the footage {self.seq.n_views}"
             )
         key_frame, key = frames[0], initial

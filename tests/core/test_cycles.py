@@ -6,6 +6,7 @@ import pytest
 from core import se3
 from core.bvh import read_bvh
 from core.cycles import (
+    CycleError,
     complete_by_mirroring,
     gait_period,
     lowpass,
@@ -27,6 +28,15 @@ def test_period_of_a_noisy_gait_is_found_to_a_fifth_of_a_frame():
     rng = np.random.default_rng(0)
     curves = np.stack([_gait(t, 37.3), _gait(t + 10, 37.3)], 1) + rng.normal(0, 1, (400, 2))
     assert gait_period(curves) == pytest.approx(37.3, abs=0.2)
+
+
+@pytest.mark.parametrize("frames", [3, 9])
+def test_curves_too_short_to_repeat_get_a_cycle_error(frames):
+    """A few frames of a swing hold no repetition past the shortest period looked for: a
+    CycleError the add-on reports, not numpy's error about an empty sequence."""
+    t = np.arange(frames, dtype=float)
+    with pytest.raises(CycleError, match="do not repeat within half their length"):
+        gait_period(np.stack([np.sin(t / 3), np.cos(t / 3)], 1))
 
 
 def test_period_of_the_cmu_walk_matches_its_footfalls(cmu_walk):
@@ -71,7 +81,7 @@ def test_mirroring_completes_a_symmetric_gait_within_half_a_degree():
     n = int(round(period))
     np.testing.assert_allclose(got, body[:n], atol=0.5)
     np.testing.assert_array_equal(got[:rec], body[:rec])  # recorded frames kept as they were
-    with pytest.raises(ValueError, match="less than half a period"):
+    with pytest.raises(CycleError, match="less than half a period"):
         complete_by_mirroring(body[:10], period, mirror)
 
 
@@ -122,7 +132,7 @@ def test_lowpass_keeps_slow_motion_drops_jitter_without_delay():
     out = lowpass(np.stack([slow + fast], 1), cutoff_hz=3.0, fps=fps)[:, 0]
     mid = slice(60, -60)
     np.testing.assert_allclose(out[mid], slow[mid], atol=0.03)  # no lag, no residue
-    with pytest.raises(ValueError, match="half the frame rate"):
+    with pytest.raises(CycleError, match="half the frame rate"):
         lowpass(np.zeros((20, 1)), cutoff_hz=70, fps=fps)
 
 

@@ -5,6 +5,7 @@ import pytest
 
 from core import se3
 from core.camera import View
+from core.errors import InputError
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
@@ -248,9 +249,9 @@ def test_a_body_that_leaves_the_images_is_reported_not_tracked(body):
 def test_bad_input_is_refused_with_a_reason(body):
     sk, pose = body
     frames = [[render(sk, pose, 0)] * 2]
-    with pytest.raises(ValueError, match="mode must be"):
+    with pytest.raises(InputError, match="mode must be"):
         Tracker(sk, frames, "perspective")
-    with pytest.raises(ValueError, match="the pose has 3 views, the footage 1"):
+    with pytest.raises(InputError, match="the pose has 3 views, the footage 1"):
         list(Tracker(sk, frames, CALIBRATED).iter_track(pose, [0, 1]))
     with pytest.raises(IndexError, match="frame 5 is outside"):
         list(Tracker(sk, [frames[0]] * 3, CALIBRATED).iter_track(pose, [0, 5]))
