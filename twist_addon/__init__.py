@@ -8,17 +8,19 @@ from . import (
     export,
     fit,
     markers,
-    operators,
     overlay,
     panels,
     properties,
     refine,
     retarget,
     smooth,
+    templates,
+    track,
+    views,
 )
 
-MODULES = (properties, operators, markers, fit, refine, body, smooth, cycle, retarget, export,
-           panels, overlay)
+MODULES = (properties, views, templates, track, markers, fit, refine, body, smooth, cycle,
+           retarget, export, panels, overlay)
 
 
 def register():

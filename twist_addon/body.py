@@ -9,8 +9,8 @@ import numpy as np
 from mathutils import Matrix
 
 from ..core.se3 import frame_along
+from .armature_action import ArmatureAction
 from .bridge import BridgeError, pose_from_armature, skeleton_from_armature
-from .reporting import ArmatureAction
 
 SIDE_COLOURS = {"Left": (0.75, 0.25, 0.2, 1.0), "Right": (0.2, 0.35, 0.75, 1.0),
                 None: (0.8, 0.75, 0.65, 1.0)}

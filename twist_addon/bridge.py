@@ -20,10 +20,11 @@ import numpy as np
 
 from ..core import se3
 from ..core.camera import View
+from ..core.errors import InputError
 from ..core.skeleton import BALL, FIXED, HINGE, Skeleton, bone_blob
 
 
-class BridgeError(ValueError):
+class BridgeError(InputError):
     """A Blender object that cannot become a core one; the message says which and why."""
 
 

@@ -13,6 +13,7 @@ import numpy as np
 from mathutils import Euler, Matrix, Quaternion
 
 from ..core.cycles import (
+    CycleError,
     complete_by_mirroring,
     continuous_quaternions,
     gait_period,
@@ -20,9 +21,9 @@ from ..core.cycles import (
     mirror_poses,
     sample,
 )
+from .armature_action import ArmatureAction
 from .bridge import BridgeError, skeleton_from_armature
 from .keyframes import TRACKED, channelbag, tracked_fcurves
-from .reporting import ArmatureAction
 
 
 class BodyMirror:
@@ -152,7 +153,7 @@ def make_cycle(arm, first: int, last: int, period: float | None = None,
     if period is None:
         try:
             period = gait_period(values[:, rotations])
-        except ValueError:
+        except CycleError:
             raise BridgeError(f"frames {first}-{last} hold too little of a walk to find its "
                               f"period: set the Period (frames per cycle)") from None
     n = int(round(period))

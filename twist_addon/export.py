@@ -7,6 +7,7 @@ from __future__ import annotations
 import bpy
 from bpy_extras.io_utils import ExportHelper
 
+from .bridge import BridgeError
 from .keyframes import channelbag
 
 
@@ -29,10 +30,10 @@ def _frame_range(arm, scene, only_cycle: bool) -> tuple[int, int]:
         return scene.frame_start, scene.frame_end
     bag = channelbag(arm)
     if bag is None:
-        raise ValueError(f"'{arm.name}' has no animation to export")
+        raise BridgeError(f"'{arm.name}' has no animation to export")
     cycled = [fc for fc in bag.fcurves if any(m.type == "CYCLES" for m in fc.modifiers)]
     if not cycled:
-        raise ValueError(f"'{arm.name}' has no cycle: use Make Walk Cycle first")
+        raise BridgeError(f"'{arm.name}' has no cycle: use Make Walk Cycle first")
     keys = [kp.co[0] for fc in cycled for kp in fc.keyframe_points]
     return int(round(min(keys))), int(round(max(keys))) - 1  # the last key closes the loop
 
@@ -70,7 +71,7 @@ class _Export(ExportHelper):
             return {"CANCELLED"}
         try:
             first, last = _frame_range(arm, context.scene, self.only_cycle)
-        except ValueError as e:
+        except BridgeError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         layer = context.view_layer

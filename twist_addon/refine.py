@@ -17,8 +17,8 @@ from ..core.pose import CALIBRATED
 from ..core.refine import SETTLED_SHIFT, SETTLED_TURN, RefineError, refine
 from ..core.skeleton import BALL, HINGE, Skeleton
 from . import keyframes
+from .armature_action import ArmatureAction
 from .bridge import BridgeError, set_pose, skeleton_from_armature
-from .reporting import ArmatureAction
 from .track import TrackSession
 
 

@@ -16,8 +16,8 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
+from .armature_action import ArmatureAction
 from .bridge import BridgeError
-from .reporting import ArmatureAction
 
 _PRESET_ITEMS = [("CMU", "CMU / BVH", "Bone names of the CMU motion capture BVH files"),
                  ("RIGIFY", "Rigify", "Blender's Rigify human metarig"),

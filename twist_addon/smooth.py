@@ -7,9 +7,9 @@ import bpy
 import numpy as np
 
 from ..core.cycles import lowpass, lowpass_quaternions
+from .armature_action import ArmatureAction
 from .bridge import BridgeError, skeleton_from_armature
 from .keyframes import TRACKED, channelbag, tracked_fcurves
-from .reporting import ArmatureAction
 
 
 def smooth_track(arm, first: int, last: int, cutoff_hz: float, fps: float) -> int:

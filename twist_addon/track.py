@@ -1,45 +1,30 @@
-"""A tracking run on the scene: gather the armature, views and footage, step the core tracker
-frame by frame, key each tracked frame. The Track operator drives it (all at once from a
-script, one frame per timer tick in the UI)."""
+"""Tracking on the scene: a run gathers the armature, views and footage, steps the core tracker
+frame by frame and keys each tracked frame; the Track operator drives it (all at once from a
+script, one frame per timer tick in the UI). Key Correction and Clear Track act on its keys.
+
+Operator ids are a public contract: ``twist.track``, ``twist.key_correction``,
+``twist.clear_track``."""
 
 from __future__ import annotations
 
-import glob
 from dataclasses import dataclass, field
 
 import bpy
 
-from ..core.job import world_root
-from ..core.pose import BodyPose
+from ..core.pose import BodyPose, world_pose
 from ..core.tracker import FrameResult, Tracker
-from ..core.video import VideoFrames, is_video
 from . import keyframes
-from .bridge import BridgeError, pose_from_armature, tracked_skeleton, view_from_camera
+from .armature_action import ArmatureAction
+from .bridge import (
+    BridgeError,
+    pose_from_armature,
+    skeleton_from_armature,
+    tracked_skeleton,
+    view_from_camera,
+)
+from .errors import INPUT_ERRORS
 from .properties import settings_from_properties
-
-
-def footage_frames(view_pg, frames: list[int]) -> list:
-    """The image (file, or decoded movie frame) of every scene frame in ``frames`` for one
-    view; BridgeError names the view and the first frame without an image."""
-    cam = view_pg.camera.name if view_pg.camera else "(no camera)"
-    if not view_pg.images:
-        raise BridgeError(f"the view of '{cam}' has no footage; set its images")
-    source = bpy.path.abspath(view_pg.images)
-    paths = VideoFrames(source) if is_video(source) else sorted(glob.glob(source))
-    if not len(paths):
-        raise BridgeError(f"the footage of the view of '{cam}' ({view_pg.images}) matches no "
-                          "file")
-    indices = []
-    for f in frames:
-        i = f - view_pg.first_frame
-        if not 0 <= i < len(paths):
-            raise BridgeError(f"the view of '{cam}' has no image for frame {f} (its "
-                              f"{len(paths)} images cover frames {view_pg.first_frame}-"
-                              f"{view_pg.first_frame + len(paths) - 1})")
-        indices.append(i)
-    if isinstance(paths, list):
-        return [paths[i] for i in indices]
-    return paths.select(indices)
+from .views import footage_frames
 
 
 @dataclass
@@ -101,9 +86,161 @@ class TrackSession:
         for res in steps:
             frame = self.frames[res.frame]
             if res.frame and not res.diverged:
-                R = res.pose.rotations.copy()
-                R[0], root = world_root(self.tracker.mode, self.initial.views[0], res.pose)
+                R, root = world_pose(self.tracker.mode, self.initial.views[0], res.pose)
                 keyframes.write_pose(self.armature, sk, frame, R, root,
                                      self.user_keys.get(frame, frozenset()))
             self.tracked.append(res)
             yield res
+
+
+def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
+    done = [r for r in session.tracked[1:] if not r.diverged]
+    diverged = [session.frames[r.frame] for r in session.tracked if r.diverged]
+    msg = f"tracked {len(done)} of {len(session.frames) - 1} frames"
+    if cancelled:
+        msg += " (stopped; the tracked frames are kept)"
+    kept = [session.frames[i] for i in session.corrections
+            if any(r.frame == i for r in session.tracked)]
+    if kept:
+        listed = ", ".join(map(str, kept)) if len(kept) <= 5 else \
+            f"{', '.join(map(str, kept[:3]))} ... {kept[-1]}"
+        msg += f"; {len(kept)} frame{'s' * (len(kept) > 1)} ({listed}) held at the pose you " \
+               "keyed"
+    notes = session.tracker.notes
+    if notes:
+        msg += "; " + "; ".join(notes)
+    if diverged:
+        last = session.tracked[-1]
+        msg += f"; stopped at frame {diverged[0]}: {last.reason}. Pose the armature there, " \
+               "Key Correction, and track again"
+        return {"WARNING"}, msg
+    return ({"WARNING"} if notes else {"INFO"}), msg
+
+
+class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
+    """Track the armature through the footage of every view, keying each tracked frame"""
+
+    bl_idname = "twist.track"
+    bl_label = "Track"
+
+    _timer = None
+    _session = None
+    _steps = None
+
+    def _start(self, context) -> bool:
+        try:
+            self._session = TrackSession.from_scene(context.scene)
+        except INPUT_ERRORS as e:
+            self.report({"ERROR"}, str(e))
+            return False
+        self._steps = self._session.run()
+        return True
+
+    def _finish(self, context, cancelled: bool = False, error: str = "") -> set:
+        """Report the run, fill the Results panel; FINISHED only when the run went through
+        its frames (a diverged frame stops it with a warning). Stopped by Esc or by an input
+        error, the frames tracked so far stay keyed, as one undo step of their own."""
+        level, msg = _summary(self._session, cancelled or bool(error))
+        self.report(level, msg)
+        if error:
+            self.report({"ERROR"}, error)
+        result, tracked = context.scene.twist.result, self._session.tracked
+        result.frames_tracked = sum(1 for r in tracked[1:] if not r.diverged)
+        result.last_residual = tracked[-1].residual if len(tracked) > 1 else 0.0
+        result.diverged_frames = ", ".join(
+            f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
+        result.notes = "\n".join(self._session.tracker.notes)
+        context.scene.frame_set(context.scene.frame_current)
+        if not (cancelled or error):
+            return {"FINISHED"}
+        if len(tracked) > 1 and bpy.ops.ed.undo_push.poll():
+            bpy.ops.ed.undo_push(message="Track (stopped)")
+        return {"CANCELLED"}
+
+    def execute(self, context):
+        if not self._start(context):
+            return {"CANCELLED"}
+        try:
+            for _ in self._steps:
+                pass
+        except INPUT_ERRORS as e:
+            return self._finish(context, error=str(e))
+        return self._finish(context)
+
+    def invoke(self, context, event):
+        if not self._start(context):
+            return {"CANCELLED"}
+        wm = context.window_manager
+        wm.progress_begin(0, len(self._session.frames))
+        self._timer = wm.event_timer_add(0.001, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            return self._end_modal(context, cancelled=True)
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        try:
+            res = next(self._steps)
+        except StopIteration:
+            return self._end_modal(context)
+        except INPUT_ERRORS as e:
+            return self._end_modal(context, error=str(e))
+        n = len(self._session.tracked)
+        context.window_manager.progress_update(n)
+        context.workspace.status_text_set(
+            f"Tracking frame {self._session.frames[res.frame]} ({n} of "
+            f"{len(self._session.frames)}), residual {res.residual:.3f} - Esc to stop")
+        return {"RUNNING_MODAL"}
+
+    def _end_modal(self, context, cancelled: bool = False, error: str = "") -> set:
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+        return self._finish(context, cancelled, error)
+
+
+class TWIST_OT_key_correction(ArmatureAction, bpy.types.Operator):
+    """Key the armature's pose on this frame as a correction: Track holds the frame at this
+    pose and holds the frames after it against it"""
+
+    bl_idname = "twist.key_correction"
+    bl_label = "Key Correction"
+
+    def run(self, context) -> str:
+        arm, frame = context.scene.twist.armature, context.scene.frame_current
+        keyframes.key_correction(arm, tracked_skeleton(arm), frame)
+        return f"keyed the pose of '{arm.name}' on frame {frame} as a correction; track again"
+
+
+class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
+    """Remove the keyframes tracking wrote on the armature, and no other"""
+
+    bl_idname = "twist.clear_track"
+    bl_label = "Clear Track"
+
+    def run(self, context) -> str:
+        arm = context.scene.twist.armature
+        n = keyframes.clear(arm, skeleton_from_armature(arm))
+        return f"removed {n} tracked keyframes from '{arm.name}'"
+
+
+def draw_pose_menu_entry(self, context):
+    """Key Correction in pose mode's right-click menu, beside Insert Keyframe, for the
+    armature being tracked."""
+    if context.object is not None and context.object == context.scene.twist.armature:
+        self.layout.separator()
+        self.layout.operator(TWIST_OT_key_correction.bl_idname, icon="KEY_HLT")
+
+
+def register():
+    bpy.types.VIEW3D_MT_pose_context_menu.append(draw_pose_menu_entry)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_pose_context_menu.remove(draw_pose_menu_entry)
+
+
+CLASSES = (TWIST_OT_track, TWIST_OT_key_correction, TWIST_OT_clear_track)

@@ -161,7 +161,7 @@ def test_template_armatures_come_back_as_their_skeletons(bpy_module, registered,
     assert bpy.ops.twist.add_template_armature(template=template) == {"FINISHED"}
     arm = bpy.context.scene.twist.armature
     back = bridge.skeleton_from_armature(arm)
-    _, _, name, kwargs = registered.twist_addon.operators.TEMPLATES[template]
+    _, _, name, kwargs = registered.twist_addon.templates.TEMPLATES[template]
     core_sk = getattr(skeleton, name)(**kwargs)
     assert back.names == core_sk.names
     assert back.kinds[1:] == core_sk.kinds[1:]  # the root moves by its keys, not by a joint

@@ -24,7 +24,7 @@ def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, fr
     assert scene.frame_end - scene.frame_start + 1 == frames
     for v in tw.views:
         assert v.images.startswith("//")  # relative: the folder can move
-        paths = twist_addon.track.footage_frames(v, list(range(scene.frame_start,
+        paths = twist_addon.views.footage_frames(v, list(range(scene.frame_start,
                                                               scene.frame_end + 1)))
         assert len(paths) == frames and all(Path(p).is_file() for p in paths)
         twist_addon.bridge.view_from_camera(v.camera, scene)  # orthographic, square pixels

@@ -213,9 +213,9 @@ def test_key_correction_keys_every_tracked_bone_as_the_users(bpy_module, registe
     assert addon.keyframes.user_keys(arm, sk) == {5: frozenset(tracked_bones)}
     # offered in pose mode's right-click menu for the tracked armature
     menu = bpy.types.VIEW3D_MT_pose_context_menu
-    assert addon.operators._pose_menu in menu.draw._draw_funcs
+    assert addon.track.draw_pose_menu_entry in menu.draw._draw_funcs
     layout = Recorder()
-    addon.operators._pose_menu(types.SimpleNamespace(layout=layout), bpy.context)
+    addon.track.draw_pose_menu_entry(types.SimpleNamespace(layout=layout), bpy.context)
     assert ("operator", ("twist.key_correction",)) in [(n, a) for n, a, _ in layout.calls]
 
 

@@ -74,9 +74,9 @@ def test_a_movie_becomes_a_view_with_the_clip_behind_its_camera(bpy_module, regi
     bg = view.camera.data.background_images[0]
     assert bg.source == "MOVIE_CLIP" and bg.clip.frame_duration == 6
     assert (scene.render.resolution_x, scene.render.resolution_y) == (64, 48)
-    track = registered.twist_addon.track
-    frames = track.footage_frames(view, [4, 8, 3])
+    views = registered.twist_addon.views
+    frames = views.footage_frames(view, [4, 8, 3])
     assert len(frames) == 3
     assert [int(round(frames[k].mean() / 30)) for k in range(3)] == [1, 5, 0]
     with pytest.raises(registered.twist_addon.bridge.BridgeError, match="no image for frame 9"):
-        track.footage_frames(view, [9])
+        views.footage_frames(view, [9])

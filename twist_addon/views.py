@@ -1,0 +1,119 @@
+"""Views: a camera per view with its footage behind it, added and removed, and the footage's
+image for each scene frame.
+
+Operator ids are a public contract: ``twist.add_view``, ``twist.remove_view``."""
+
+from __future__ import annotations
+
+import glob
+from pathlib import Path
+
+import bpy
+
+from ..core.video import VideoFrames, is_video
+from .bridge import BridgeError
+from .properties import first_frame_property
+
+
+def footage_frames(view_pg, frames: list[int]) -> list:
+    """The image (file, or decoded movie frame) of every scene frame in ``frames`` for one
+    view; BridgeError names the view and the first frame without an image."""
+    cam = view_pg.camera.name if view_pg.camera else "(no camera)"
+    if not view_pg.images:
+        raise BridgeError(f"the view of '{cam}' has no footage; set its images")
+    source = bpy.path.abspath(view_pg.images)
+    paths = VideoFrames(source) if is_video(source) else sorted(glob.glob(source))
+    if not len(paths):
+        raise BridgeError(f"the footage of the view of '{cam}' ({view_pg.images}) matches no "
+                          "file")
+    indices = []
+    for f in frames:
+        i = f - view_pg.first_frame
+        if not 0 <= i < len(paths):
+            raise BridgeError(f"the view of '{cam}' has no image for frame {f} (its "
+                              f"{len(paths)} images cover frames {view_pg.first_frame}-"
+                              f"{view_pg.first_frame + len(paths) - 1})")
+        indices.append(i)
+    if isinstance(paths, list):
+        return [paths[i] for i in indices]
+    return paths.select(indices)
+
+
+class TWIST_OT_add_view(bpy.types.Operator):
+    """Add a view: an orthographic camera with the footage behind it, one image per frame"""
+
+    bl_idname = "twist.add_view"
+    bl_label = "Add View"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: bpy.props.StringProperty(
+        name="Footage", subtype="FILE_PATH",
+        description="A movie, or any image of the footage: its folder's images of the same "
+                    "kind are read in name order")
+    first_frame: first_frame_property()
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        path = Path(bpy.path.abspath(self.filepath))
+        if not path.is_file():
+            self.report({"ERROR"}, f"{self.filepath}: no such image or movie file")
+            return {"CANCELLED"}
+        movie = is_video(path)
+        pattern = str(path) if movie else str(path.parent / f"*{path.suffix}")
+        scene = context.scene
+        n = len(scene.twist.views) + 1
+        cam_data = bpy.data.cameras.new(f"View {n}")
+        cam_data.type = "ORTHO"
+        cam_data.show_background_images = True
+        cam = bpy.data.objects.new(f"View {n}", cam_data)
+        context.collection.objects.link(cam)
+        cam.location = (0.0, -10.0, 1.0)
+        cam.rotation_euler = (1.5707963, 0.0, 0.0)  # looking along +y, z up: a side view
+        bg = cam_data.background_images.new()
+        bg.frame_method = "FIT"
+        if movie:
+            clip = bpy.data.movieclips.load(str(path), check_existing=True)
+            clip.frame_start = self.first_frame
+            bg.source, bg.clip = "MOVIE_CLIP", clip
+            count, (img_w, img_h) = clip.frame_duration, clip.size
+        else:
+            count = len(glob.glob(pattern))
+            image = bpy.data.images.load(str(path), check_existing=True)
+            img_w, img_h = image.size  # a sequence reports no size until it is shown
+            image.source = "SEQUENCE" if count > 1 else "FILE"
+            bg.image = image
+            bg.image_user.frame_start = self.first_frame
+            bg.image_user.frame_duration = count
+        if img_w and img_h and n == 1:
+            scene.render.resolution_x, scene.render.resolution_y = img_w, img_h
+        view = scene.twist.views.add()
+        view.camera = cam
+        view.images = bpy.path.relpath(pattern) if bpy.data.filepath else pattern
+        view.first_frame = self.first_frame
+        scene.twist.active_view = len(scene.twist.views) - 1
+        self.report({"INFO"}, f"added '{cam.name}' with {count} frames")
+        return {"FINISHED"}
+
+
+class TWIST_OT_remove_view(bpy.types.Operator):
+    """Remove the selected view (its camera stays in the scene)"""
+
+    bl_idname = "twist.remove_view"
+    bl_label = "Remove View"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return len(context.scene.twist.views) > 0
+
+    def execute(self, context):
+        tw = context.scene.twist
+        tw.views.remove(tw.active_view)
+        tw.active_view = max(0, min(tw.active_view, len(tw.views) - 1))
+        return {"FINISHED"}
+
+
+CLASSES = (TWIST_OT_add_view, TWIST_OT_remove_view)
