@@ -154,7 +154,7 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     return out
 
 
-@dataclass
+@dataclass(kw_only=True)
 class FrameResult:
     """One tracked frame: its pose and the facts the UI, the report and the benchmark read."""
 
@@ -605,8 +605,9 @@ class Tracker:
             sigmas = smp.sigmas
             left = self._left_views(smp)
             if left:
-                return FrameResult(frame, est, float("nan"), total_iters, False, True, left,
-                                   time.perf_counter() - t0)
+                return FrameResult(frame=frame, pose=est, residual=float("nan"),
+                                   iterations=total_iters, converged=False, diverged=True,
+                                   reason=left, seconds=time.perf_counter() - t0)
             ne = self._normal_equations(kin, sets, smp, sigmas, level)
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
@@ -639,7 +640,8 @@ class Tracker:
                     if lam > 1e4:
                         converged = True  # no step lowers the cost: a minimum at this level
                         break
-        result = FrameResult(frame, est, self._residual(sets, smp, sigmas), total_iters, converged)
+        result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
+                             iterations=total_iters, converged=converged)
         left = self._left_views(smp)
         if left:
             result.diverged, result.reason = True, left
@@ -695,7 +697,8 @@ class Tracker:
                 "another side, or track side-on, as hinges about the line of sight (Side on "
                 "in the Track settings; side_on in a job)")
         self._scale_to(initial)
-        first = FrameResult(key_frame, initial.copy(), 0.0, 0, True, given=True)
+        first = FrameResult(frame=key_frame, pose=initial.copy(), residual=0.0, iterations=0,
+                            converged=True, given=True)
         yield first
         history = [first]
         residuals: list[float] = []
@@ -706,7 +709,8 @@ class Tracker:
             if frame in corrections:
                 key_frame, key = frame, corrections[frame].copy()
                 self._key_sets.clear()
-                res = FrameResult(frame, key.copy(), 0.0, 0, True, given=True)
+                res = FrameResult(frame=frame, pose=key.copy(), residual=0.0, iterations=0,
+                                  converged=True, given=True)
                 self.seq.keep_only({(c, frame) for c in range(self.seq.n_views)})
                 yield res
                 # the step from a given pose is a velocity; from a tracked one it is mostly
@@ -719,7 +723,8 @@ class Tracker:
                 with one_blas_thread():
                     res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
             except DegenerateSystem as e:
-                res = FrameResult(frame, pred, float("nan"), 0, False, True, str(e))
+                res = FrameResult(frame=frame, pose=pred, residual=float("nan"), iterations=0,
+                                  converged=False, diverged=True, reason=str(e))
             if not res.diverged:
                 if not all(np.isfinite(res.pose.rotations).flat):
                     res.diverged, res.reason = True, "the solution is not finite"
