@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test lint bench extension clean
+.PHONY: venv demo test lint bench bench-quick bench-walk extension clean
 
 venv: $(STAMP)
 
@@ -24,8 +24,18 @@ test: venv
 lint: venv
 	$(VENV)/bin/ruff check core twist_addon bench tests scripts example_blends
 
-# The tracking benchmark (renders its footage once into .cache/, ~10 minutes).
+# The benchmark suite: many motions and looks, tracked with the defaults; writes
+# docs/BENCHMARK.md. Renders its footage once into .cache/suite/. Add the Bandai Namco
+# clips (never stored here) with BENCH_ARGS="--bandai-namco FOLDER".
 bench: venv
+	$(PY) bench/suite.py --write docs/BENCHMARK.md $(BENCH_ARGS)
+
+# The suite's quick check for every change: the CMU clips at 15 fps.
+bench-quick: venv
+	$(PY) bench/suite.py --quick $(BENCH_ARGS)
+
+# The one-clip walk benchmark with its references for one view and one step.
+bench-walk: venv
 	$(PY) bench/walk_benchmark.py
 
 # The installable extension, one zip per platform, into dist/ (downloads its wheels once).

@@ -41,17 +41,18 @@ def _point(sk: Skeleton, frames: np.ndarray, name: str) -> np.ndarray:
     return M[:3, :3] @ sk.end_sites[sk.index(joint)][0] + M[:3, 3] if end else M[:3, 3]
 
 
-def limb_ends(sk: Skeleton, rotations, roots) -> dict[str, np.ndarray]:
-    """World positions (F, 3) of every limb end named in ``LIMBS``."""
+def limb_ends(sk: Skeleton, rotations, roots, limbs=LIMBS) -> dict[str, np.ndarray]:
+    """World positions (F, 3) of every limb end named in ``limbs`` ((label, from, to), the
+    eight limb bones first; by default the CMU walk's ``LIMBS``)."""
     frames = [sk.joint_frames(R, p) for R, p in zip(rotations, roots)]
-    names = {name for _, a, b in LIMBS for name in (a, b)}
+    names = {name for _, a, b in limbs for name in (a, b)}
     return {name: np.array([_point(sk, M, name) for M in frames]) for name in sorted(names)}
 
 
-def limb_vectors(sk: Skeleton, rotations, roots) -> dict[str, np.ndarray]:
+def limb_vectors(sk: Skeleton, rotations, roots, limbs=LIMBS) -> dict[str, np.ndarray]:
     """World direction vectors (F, 3) of each limb."""
-    ends = limb_ends(sk, rotations, roots)
-    return {label: ends[b] - ends[a] for label, a, b in LIMBS}
+    ends = limb_ends(sk, rotations, roots, limbs)
+    return {label: ends[b] - ends[a] for label, a, b in limbs}
 
 
 @dataclass
@@ -64,12 +65,12 @@ class Scores:
 
 
 def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
-          unit_mm: float = 1000.0) -> Scores:
+          unit_mm: float = 1000.0, limbs=LIMBS) -> Scores:
     """Compare (rotations, roots) of an estimate with the truth over the same frames."""
     F = min(len(est[0]), len(truth[0]))
     est = (est[0][:F], est[1][:F])
     truth = (truth[0][:F], truth[1][:F])
-    ve, vt = limb_vectors(sk, *est), limb_vectors(sk, *truth)
+    ve, vt = limb_vectors(sk, *est, limbs), limb_vectors(sk, *truth, limbs)
     per = {k: np.degrees(se3.angle_between_vectors(ve[k], vt[k])) for k in ve}
     pe, pt = world_points(sk, *est), world_points(sk, *truth)
     rel = (pe - pe[:, :1]) - (pt - pt[:, :1])
@@ -78,7 +79,7 @@ def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
         j = sk.index(n)
         angle = se3.rotation_angle_between(est[0][:, j], truth[0][:, j])
         local[n] = float(np.degrees(angle).mean())
-    per_frame = np.mean([per[k] for k in HEADLINE], axis=0)
+    per_frame = np.mean([per[label] for label, _, _ in limbs[:8]], axis=0)
     return Scores({k: float(v.mean()) for k, v in per.items()}, float(per_frame.mean()),
                   float(np.linalg.norm(rel, axis=-1).mean() * unit_mm), local, per_frame)
 
@@ -87,12 +88,13 @@ def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:
     return bvh.poses()
 
 
-def image_error_px(sk: Skeleton, est: tuple, truth: tuple, views: list) -> float:
-    """Mean distance (pixels) between tracked and true limb ends (the joints of ``LIMBS``)
+def image_error_px(sk: Skeleton, est: tuple, truth: tuple, views: list, limbs=LIMBS) -> float:
+    """Mean distance (pixels) between tracked and true limb ends (the joints of ``limbs``)
     as each of ``views`` (``core.camera.View``) shows them: how far the tracked body's
     overlay strays from the body in the footage, which even one view sees."""
     F = min(len(est[0]), len(truth[0]))
-    pe, pt = (np.concatenate(list(limb_ends(sk, R[:F], p[:F]).values())) for R, p in (est, truth))
+    pe, pt = (np.concatenate(list(limb_ends(sk, R[:F], p[:F], limbs).values()))
+              for R, p in (est, truth))
     return float(np.mean([np.linalg.norm(v.project(pe) - v.project(pt), axis=1).mean()
                           for v in views]))
 

@@ -145,8 +145,9 @@ def cloth_colour(P: np.ndarray, seed: int = 7) -> np.ndarray:
     return np.clip(base + 0.6 * blotch[:, None], 0.02, 0.98)
 
 
-def _capsule_body(sk, spacing: float = 0.01, around: int = 32):
-    """A body of tapered elliptical capsules, one per bone (joint to child or end site).
+def _capsule_body(sk, radii: dict = RADII, spacing: float = 0.01, around: int = 32):
+    """A body of tapered elliptical capsules, one per bone (joint to child or end site), with
+    ``radii`` (metres, across and front to back) by joint name.
 
     Returns vertices (N, 3) in the rest pose, quad faces (M, 4) and, per vertex, its joint and
     weight and its parent joint and weight (blended over the first fifth of the bone, so that
@@ -159,12 +160,12 @@ def _capsule_body(sk, spacing: float = 0.01, around: int = 32):
         tips = [(sk.rest_positions[c], sk.names[c]) for c in sk.children(j)
                 if not any(x in sk.names[c] for x in SKIPPED)]
         tips += [(a + e, None) for e in sk.end_sites[j]]
-        ra = np.array(RADII.get(name, DEFAULT_RADIUS))
+        ra = np.array(radii.get(name, DEFAULT_RADIUS))
         for tip, tip_name in tips:
             L = float(np.linalg.norm(tip - a))
             if L < 1e-4:
                 continue
-            rb = np.array(RADII.get(tip_name, 0.8 * ra)) if tip_name else 0.8 * ra
+            rb = np.array(radii.get(tip_name, 0.8 * ra)) if tip_name else 0.8 * ra
             u = (tip - a) / L
             v = np.array([1.0, 0, 0]) - u[0] * u
             if np.linalg.norm(v) < 0.3:
@@ -196,15 +197,17 @@ def _capsule_body(sk, spacing: float = 0.01, around: int = 32):
     return np.array(verts), np.array(faces), groups
 
 
-def build_scene(bpy, bvh_path: Path, zoom: int = 1):
-    """Import the capture, build the skinned body, set up Workbench; returns the armature."""
+def build_scene(bpy, bvh_path: Path, zoom: int = 1, radii: dict = RADII,
+                width: int = WIDTH, height: int = HEIGHT):
+    """Import the capture, build the skinned body (``radii`` by joint name), set up
+    Workbench for ``zoom`` times width x height; returns the armature and the body."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_anim.bvh(filepath=str(bvh_path), axis_forward="Y", axis_up="Z",
                             frame_start=1, rotate_mode="NATIVE")
     arm = bpy.context.selected_objects[0]
     sk = skeleton_from_bvh(read_bvh(bvh_path))
 
-    P, faces, groups = _capsule_body(sk)
+    P, faces, groups = _capsule_body(sk, radii)
     mesh = bpy.data.meshes.new("body")
     mesh.from_pydata(P.tolist(), [], faces.tolist())
     mesh.shade_smooth()
@@ -237,7 +240,7 @@ def build_scene(bpy, bvh_path: Path, zoom: int = 1):
     scene.display.shading.color_type = "VERTEX"
     scene.display.shading.show_shadows = False
     scene.display.shading.show_cavity = False
-    scene.render.resolution_x, scene.render.resolution_y = WIDTH * zoom, HEIGHT * zoom
+    scene.render.resolution_x, scene.render.resolution_y = width * zoom, height * zoom
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
     scene.render.image_settings.color_mode = "RGBA"
@@ -250,12 +253,15 @@ def build_scene(bpy, bvh_path: Path, zoom: int = 1):
     return arm, body
 
 
-def add_camera(bpy, name: str, R: np.ndarray):
+def add_camera(bpy, name: str, R: np.ndarray, centre: np.ndarray = STAGE_CENTRE,
+               metres_across: float = WIDTH / PIXELS_PER_METRE):
+    """An orthographic camera with world-to-camera rotation ``R`` looking at ``centre``
+    and ``metres_across`` wide."""
     from mathutils import Matrix
 
     cam_data = bpy.data.cameras.new(name)
     cam_data.type = "ORTHO"
-    cam_data.ortho_scale = WIDTH / PIXELS_PER_METRE
+    cam_data.ortho_scale = metres_across
     cam_data.clip_start, cam_data.clip_end = 0.01, 100.0
     cam = bpy.data.objects.new(name, cam_data)
     bpy.context.collection.objects.link(cam)
@@ -263,7 +269,7 @@ def add_camera(bpy, name: str, R: np.ndarray):
     rot = R.T @ np.diag([1.0, -1.0, -1.0])
     M = np.eye(4)
     M[:3, :3] = rot
-    M[:3, 3] = STAGE_CENTRE - 10.0 * R[2]  # 10 m back along the viewing direction
+    M[:3, 3] = centre - 10.0 * R[2]  # 10 m back along the viewing direction
     cam.matrix_world = Matrix(M.tolist())
     return cam
 

@@ -1,0 +1,228 @@
+"""The benchmark suite: many motions, skeletons and looks, tracked with the default settings
+and scored against the capture beside two references on the same frames.
+
+    python bench/suite.py [--quick] [--bandai-namco FOLDER] [--settings JSON]
+                          [--clips NAME,...] [--looks NAME,...] [--write PATH]
+
+Each clip (a capture of ``captures.NAMINGS``) is rendered once per look
+(``suite_footage.LOOKS``) into ``.cache/suite/`` and tracked through ``python -m core
+track``, as a user runs it: three calibrated views (the lower back free) and one lateral
+view (the paper's 19 degrees of freedom), at 15 fps, and with the full suite at 30 fps too.
+The tracker's body is what a job gets without blobs of its own (``Skeleton.default_blobs``),
+its hinges' axes the capture's own. Scored: the limb-direction error over the eight limbs
+(a run that stops keeps its last pose, as a user's keys would), beside the first frame held
+still and the best fit of the tracked degrees of freedom to the true joints; for one view
+also how far the limb ends stray in its image, in % of the body's height. ``--quick`` (the
+check for every change, a few minutes once the footage is rendered): the CMU clips at 15
+fps. The Bandai Namco clips are non-commercial and never stored in the repository: give
+the folder that holds them (``bn_*.bvh``) to include them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import evaluate  # noqa: E402
+from captures import Parts  # noqa: E402
+from suite_footage import (  # noqa: E402
+    LOOKS,
+    PIXELS_PER_METRE,
+    VIDEO_FPS,
+    VIEWS,
+    Clip,
+    render_look,
+    stage,
+)
+from walk_benchmark import track_job  # noqa: E402
+
+from core.bvh import read_bvh  # noqa: E402
+from core.job import load_job  # noqa: E402
+from core.skeleton import skeleton_from_bvh  # noqa: E402
+
+DATA = ROOT / "bench" / "data"
+CACHE = ROOT / ".cache" / "suite"
+CLIPS = [  # two seconds each, file frames at the capture's rate
+    Clip("CMU 131 walk", DATA / "cmu_131_01_walk.bvh", 540, 780),
+    Clip("CMU 05-01 walk", DATA / "cmu05_01_walk.bvh", 0, 240),
+    Clip("CMU 01-01 jumps", DATA / "cmu01_01_forward_jumps.bvh", 0, 240),
+    Clip("CMU 05-10 dance", DATA / "cmu05_10_dance_arms_high.bvh", 0, 240),
+    Clip("CMU 06-10 left turn", DATA / "cmu06_10_walk_left_turns.bvh", 0, 240),
+]
+BANDAI_NAMCO = [  # (name, file, first, last) at 30 fps
+    ("BN brisk walk", "bn_walk_brisk_active.bvh", 0, 60),
+    ("BN arm swing", "bn_walk_happy_armswing.bvh", 30, 90),
+    ("BN old walk", "bn_walk_old.bvh", 60, 120),
+    ("BN left turn", "bn_walk_turn_left.bvh", 60, 120),
+    ("BN waving", "bn_wave_both_hands.bvh", 60, 120),
+    ("BN dance", "bn_dance_short.bvh", 510, 570),
+]
+# run: (views, video frames per tracked frame, lower back free)
+RUNS = {
+    "3 views 15 fps": (list(VIEWS), 2, True),
+    "1 lateral view 15 fps": (["lateral"], 2, False),
+    "3 views 30 fps": (list(VIEWS), 1, True),
+    "1 lateral view 30 fps": (["lateral"], 1, False),
+}
+QUICK_RUNS = ("3 views 15 fps", "1 lateral view 15 fps")
+
+
+def slug(text: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in text.lower())
+
+
+def write_job(clip_dir: Path, look: str, run: str, settings: dict) -> Path:
+    """The job tracking one run of one clip in one look (its footage rendered)."""
+    views, step, lower_back = RUNS[run]
+    truth = read_bvh(clip_dir / "truth.bvh")
+    sk = skeleton_from_bvh(truth)
+    R, _ = truth.poses()
+    cams = json.loads((clip_dir / "cameras.json").read_text())
+    ext = "jpg" if LOOKS[look].jpeg else "png"
+    frames = range(0, len(R), step)
+    job = {
+        "skeleton": {"bvh": "truth.bvh",
+                     "joints": Parts.of(sk.names).tracked_joints(sk, R, lower_back)},
+        "initial": {"bvh": "truth.bvh", "frame": 0},
+        "views": [{"images": [f"{slug(look)}/{v}/{f:04d}.{ext}" for f in frames],
+                   "camera": cams[v]} for v in views],
+        "mode": "calibrated",
+        "settings": settings,
+        "frame_time": step / VIDEO_FPS,
+    }
+    # the footage folder is named by the look itself; the job beside it
+    path = clip_dir / f"{slug(look)}__{slug(run)}.json"
+    path.write_text(json.dumps(job, indent=1))
+    return path
+
+
+def score_run(job_path: Path, run: str) -> dict:
+    """Track one job and score it; the references are computed here too (cheap beside the
+    tracking, and each run's own frames)."""
+    views, step, _ = RUNS[run]
+    out = job_path.with_suffix(".bvh")
+    rep_path = job_path.with_suffix(".report.json")
+    code, peak_mb = track_job(job_path, out, rep_path)
+    if code not in (0, 3):
+        raise SystemExit(f"{job_path.name}: the tracker failed (exit {code})")
+    rep = json.loads(rep_path.read_text())
+    job = load_job(job_path)
+    sk = job.skeleton
+    limbs = Parts.of(sk.names).limbs()
+    R, p = read_bvh(job_path.parent / "truth.bvh").poses()
+    truth = (R[::step], p[::step])
+    est = read_bvh(out).poses()
+    n = len(truth[0])
+    if len(est[0]) < n:  # stopped early: the last pose is kept, as the keys would hold it
+        pad = n - len(est[0])
+        est = (np.concatenate([est[0], np.repeat(est[0][-1:], pad, 0)]),
+               np.concatenate([est[1], np.repeat(est[1][-1:], pad, 0)]))
+    names = sk.tracked_joint_names()
+    tracker = evaluate.score(sk, names, est, truth, limbs=limbs)
+    still = evaluate.score(sk, names, evaluate.held_still(truth), truth, limbs=limbs)
+    best = evaluate.score(sk, names, evaluate.best_fit(sk, truth), truth, limbs=limbs)
+    row = {"tracker": tracker.limb_mean_deg, "still": still.limb_mean_deg,
+           "best": best.limb_mean_deg, "frames": f"{rep['frames_tracked']}/{n}",
+           "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],
+           "peak_mb": peak_mb}
+    if len(views) == 1:
+        height_px = sk.height() * PIXELS_PER_METRE
+        px = evaluate.image_error_px(sk, est, truth, job.cameras, limbs)
+        row["image_pct"] = 100 * px / height_px
+    return row
+
+
+def table(rows: dict, runs: list[str]) -> list[str]:
+    """The per-clip table and the summary, as markdown lines."""
+    out = ["| clip | look | run | tracker | held still | best fit | frames | image err |",
+           "|---|---|---|---|---|---|---|---|"]
+    for (clip, look, run), r in rows.items():
+        img = f"{r['image_pct']:.1f} %" if "image_pct" in r else ""
+        out.append(f"| {clip} | {look} | {run} | {r['tracker']:.1f}° | {r['still']:.1f}° |"
+                   f" {r['best']:.1f}° | {r['frames']}{' (stopped)' if r['diverged'] else ''}"
+                   f" | {img} |")
+    out += ["", "| run | median | worst | median over best fit | worst over best fit |"
+            " beats held still | stopped | median image err | tracking fps | peak memory |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
+    for run in runs:
+        rs = [r for (_, _, rn), r in rows.items() if rn == run]
+        if not rs:
+            continue
+        err = [r["tracker"] for r in rs]
+        over = [r["tracker"] - r["best"] for r in rs]
+        img = [r["image_pct"] for r in rs if "image_pct" in r]
+        out.append(
+            f"| {run} | {statistics.median(err):.1f}° | {max(err):.1f}° |"
+            f" {statistics.median(over):+.1f}° | {max(over):+.1f}° |"
+            f" {sum(r['tracker'] < r['still'] for r in rs)}/{len(rs)} |"
+            f" {sum(r['diverged'] for r in rs)} |"
+            f" {f'{statistics.median(img):.1f} %' if img else ''} |"
+            f" {statistics.median(r['fps'] for r in rs):.1f} |"
+            f" {max(r['peak_mb'] for r in rs):.0f} MB |")
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="the CMU clips at 15 fps only")
+    ap.add_argument("--bandai-namco", type=Path, metavar="FOLDER",
+                    help="the folder holding the Bandai Namco clips (bn_*.bvh), to add them")
+    ap.add_argument("--clips", help="comma-separated clip names (default: all)")
+    ap.add_argument("--looks", default=",".join(LOOKS), help="comma-separated look names")
+    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
+    ap.add_argument("--write", type=Path, help="also write the tables to this markdown file")
+    a = ap.parse_args(argv)
+    clips = list(CLIPS)
+    if a.bandai_namco and not a.quick:
+        for name, file, first, last in BANDAI_NAMCO:
+            path = a.bandai_namco / file
+            if not path.is_file():
+                raise SystemExit(f"{path}: no such file (the Bandai Namco clips: "
+                                 f"{', '.join(f for _, f, _, _ in BANDAI_NAMCO)})")
+            clips.append(Clip(name, path, first, last))
+    if a.clips:
+        clips = [c for c in clips if c.name in a.clips.split(",")]
+    looks = a.looks.split(",")
+    runs = list(QUICK_RUNS if a.quick else RUNS)
+    settings = json.loads(a.settings)
+    t0 = time.perf_counter()
+    jobs = []
+    for clip in clips:
+        clip_dir = CACHE / slug(clip.name)
+        stage(clip, clip_dir)
+        for look in looks:
+            rendered = render_look(clip_dir, look, clip_dir / slug(look))
+            if rendered:
+                print(f"{clip.name}, {look}: rendered {rendered} images"
+                      f" ({time.perf_counter() - t0:.0f} s)", flush=True)
+            jobs += [((clip.name, look, run), write_job(clip_dir, look, run, settings))
+                     for run in runs]
+    rows = {}
+    with ThreadPoolExecutor(2) as pool:  # one tracker per core (each uses one BLAS thread)
+        for key, row in zip([k for k, _ in jobs],
+                            pool.map(lambda kj: score_run(kj[1], kj[0][2]), jobs)):
+            rows[key] = row
+            print(f"{' / '.join(key)}: {row['tracker']:.1f}° (held still {row['still']:.1f},"
+                  f" best fit {row['best']:.1f}), {row['frames']}", flush=True)
+    lines = table(rows, runs)
+    lines.append(f"\nsuite time {time.perf_counter() - t0:.0f} s; {len(clips)} clips x"
+                 f" {len(looks)} looks x {len(runs)} runs")
+    print("\n".join(lines))
+    if a.write:
+        a.write.write_text("\n".join(lines) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,210 @@
+"""Footage for the benchmark suite: a capture rendered through three views in one of several
+looks that vary what real footage varies.
+
+A look sets the body's cloth (its texture and its contrast with what is behind it), the
+backdrop (Muybridge's ruled black, a bright brick wall, a busy park-like scene), the light
+(soft studio, or hard sun with shadows on the body), motion blur (sub-frames averaged over
+half the frame interval), sensor noise and JPEG compression. The body is the same skinned
+capsule body as the walk benchmark's (``walk_footage``), sized by the capture's parts.
+
+Footage is rendered at 30 frames per second (15 fps runs take every other frame) into
+``<clip folder>/<look folder>/<view>/NNNN.png|jpg`` (frames from 0), with ``truth.bvh``
+(the capture at 30 fps, in metres) and ``cameras.json`` in the clip's folder; footage
+already rendered with the same look and frames is kept.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+from captures import Parts, normalized
+from walk_footage import RADII, add_camera, backdrop, build_scene, cloth_colour
+
+from core.bvh import write_bvh
+from core.skeleton import skeleton_from_bvh
+
+WIDTH, HEIGHT = 480, 360
+PIXELS_PER_METRE = 125.0  # a 1.7 m body stands about 210 px tall; 3.8 m of stage across
+VIDEO_FPS = 30
+VIEWS = ("lateral", "endon", "oblique60")
+
+
+@dataclass(frozen=True)
+class Look:
+    cloth: str  # "woven" (blotchy weave), "plain" (one light colour), "stripes" (dark/light)
+    backdrop: str  # "ruled" (dark, light lines), "bricks" (a bright wall), "park" (busy)
+    light: str  # "studio" (soft) or "sun" (hard, with shadows)
+    blur: int  # sub-frames averaged per frame (1: no motion blur)
+    noise: float  # sensor noise, grey levels of 255
+    jpeg: int  # JPEG quality (0: lossless PNG)
+
+
+LOOKS = {
+    "muybridge": Look("woven", "ruled", "studio", 1, 2.0, 0),
+    "sunlit wall": Look("plain", "bricks", "sun", 1, 3.0, 75),
+    "park video": Look("stripes", "park", "studio", 3, 4.0, 60),
+}
+
+
+@dataclass(frozen=True)
+class Clip:
+    name: str
+    path: Path  # a capture of one of captures.NAMINGS
+    first: int  # file frames first..last (inclusive) at the capture's own rate
+    last: int
+
+
+def _smooth_noise(rng, shape, scale: float) -> np.ndarray:
+    import cv2
+
+    small = rng.normal(size=(max(shape[0] // int(scale), 2) + 2,
+                             max(shape[1] // int(scale), 2) + 2))
+    big = cv2.resize(small, (shape[1] + 2 * int(scale), shape[0] + 2 * int(scale)),
+                     interpolation=cv2.INTER_CUBIC)
+    return big[int(scale):int(scale) + shape[0], int(scale):int(scale) + shape[1]]
+
+
+def backdrop_image(kind: str, seed: int) -> np.ndarray:
+    """A still backdrop, BGR 0..255 (HEIGHT, WIDTH, 3)."""
+    rng = np.random.default_rng(seed)
+    if kind == "ruled":
+        return backdrop()
+    if kind == "bricks":  # light bricks 30 x 12 px, offset every other row, pale mortar
+        y, x = np.mgrid[:HEIGHT, :WIDTH]
+        row = y // 12
+        col = (x + 15 * (row % 2)) // 30
+        tint = rng.normal(0, 12, (row.max() + 1, col.max() + 2))[row, col]
+        img = np.empty((HEIGHT, WIDTH, 3))
+        img[:] = (150.0, 175.0, 205.0)  # BGR: a warm light wall
+        img += tint[..., None]
+        mortar = (y % 12 == 0) | ((x + 15 * (row % 2)) % 30 == 0)
+        img[mortar] = (190.0, 200.0, 210.0)
+        return img + 8 * _smooth_noise(rng, (HEIGHT, WIDTH), 40)[..., None]
+    if kind == "park":  # foliage and trunks: texture at several scales, greens and browns
+        leaves = sum(w * _smooth_noise(rng, (HEIGHT, WIDTH), s)
+                     for w, s in ((0.5, 3), (0.8, 9), (1.0, 30), (0.7, 90)))
+        img = np.stack([40 + 18 * leaves, 95 + 30 * leaves, 70 + 20 * leaves], -1)
+        for x0 in rng.uniform(0, WIDTH, 5).astype(int):  # dark trunks
+            w = int(rng.uniform(6, 18))
+            img[:, x0:x0 + w] = (40.0, 55.0, 70.0) + 10 * rng.normal(size=(HEIGHT, 1, 1))
+        ground = np.arange(HEIGHT) > 0.8 * HEIGHT
+        img[ground] = (90.0, 130.0, 150.0) + 15 * rng.normal(size=(int(ground.sum()), WIDTH, 3))
+        return img
+    raise ValueError(f"no backdrop '{kind}'")
+
+
+def cloth(kind: str, P: np.ndarray) -> np.ndarray:
+    """Vertex colours (N, 3) RGB in [0, 1] of rest-pose positions P (N, 3)."""
+    if kind == "woven":
+        return cloth_colour(P)
+    if kind == "plain":  # light beige with faint blotches: little texture, low contrast
+        blotch = np.sin(P @ np.array([31.0, 17.0, 23.0])) * 0.03
+        return np.clip(np.array([0.78, 0.70, 0.58]) + blotch[:, None], 0, 1)
+    if kind == "stripes":  # navy and white bands around the body every 8 cm
+        band = np.sin(P[:, 1] * 2 * np.pi / 0.08) > 0
+        return np.where(band[:, None], [0.9, 0.9, 0.85], [0.1, 0.12, 0.3])
+    raise ValueError(f"no cloth '{kind}'")
+
+
+def view_rotations(lateral: np.ndarray) -> dict[str, np.ndarray]:
+    """World-to-camera rotations (rows: image x, image y down, viewing direction) for a body
+    whose left points along ``lateral`` (horizontal): the lateral view looks across it from
+    its right, the end-on view at its front, the oblique one 60 degrees between."""
+    up = np.array([0.0, 1.0, 0.0])
+    side = lateral / np.linalg.norm(lateral)
+    forward = np.cross(side, up)
+
+    def look(d):
+        z = d / np.linalg.norm(d)
+        return np.stack([np.cross(-up, z), -up, z])
+
+    a = np.radians(60)
+    return {"lateral": look(side), "endon": look(-forward),
+            "oblique60": look(np.cos(a) * side - np.sin(a) * forward)}
+
+
+def job_camera(R: np.ndarray, centre: np.ndarray) -> dict:
+    return {"model": "scaled_orthographic", "R": R.tolist(), "t": (-R @ centre).tolist(),
+            "scale": PIXELS_PER_METRE, "center": [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5]}
+
+
+def stage(clip: Clip, out: Path) -> dict:
+    """Write OUT/truth.bvh (the clip at 30 fps) and OUT/cameras.json; return the cameras."""
+    bvh = normalized(clip.path, clip.first, clip.last)
+    step = max(int(round(1 / bvh.frame_time / VIDEO_FPS)), 1)
+    bvh.motion = bvh.motion[::step]
+    bvh.frame_time *= step
+    out.mkdir(parents=True, exist_ok=True)
+    write_bvh(bvh, out / "truth.bvh")
+    sk = skeleton_from_bvh(bvh)
+    parts = Parts.of(bvh.names)
+    R, root = bvh.poses()
+    X = sk.world_positions(R[0], root[0])
+    lateral = X[sk.index(parts.roles["thigh.L"])] - X[sk.index(parts.roles["thigh.R"])]
+    lateral[1] = 0.0
+    centre = root.mean(0)
+    cams = {v: job_camera(Rv, centre) for v, Rv in view_rotations(lateral).items()}
+    (out / "cameras.json").write_text(json.dumps(cams, indent=1))
+    return cams
+
+
+def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
+    """Render every frame of ``clip_dir/truth.bvh`` in every view in the look into
+    ``out/<view>/``; returns how many images were rendered now (0: all were there)."""
+    import bpy
+    import cv2
+
+    look = LOOKS[look_name]
+    stamp = out / "look.json"
+    truth = clip_dir / "truth.bvh"
+    from core.bvh import read_bvh
+
+    n = len(read_bvh(truth).motion)
+    meta = {"look": asdict(look), "frames": n, "version": 1}
+    ext = "jpg" if look.jpeg else "png"
+    done = stamp.is_file() and json.loads(stamp.read_text()) == meta
+    if done and all((out / v / f"{n - 1:04d}.{ext}").is_file() for v in VIEWS):
+        return 0
+    cams = json.loads((clip_dir / "cameras.json").read_text())
+    sk = skeleton_from_bvh(read_bvh(truth))
+    parts = Parts.of(sk.names)
+    _, body = build_scene(bpy, truth, radii=parts.radii(RADII), width=WIDTH, height=HEIGHT)
+    P = np.array([v.co for v in body.data.vertices])
+    rgba = np.concatenate([cloth(look.cloth, P), np.ones((len(P), 1))], 1)
+    body.data.color_attributes["cloth"].data.foreach_set("color",
+                                                         rgba.astype(np.float32).ravel())
+    scene = bpy.context.scene
+    if look.light == "sun":
+        scene.display.shading.show_shadows = True
+        scene.display.shadow_shift = 0.1
+        scene.display.shading.shadow_intensity = 0.7
+        scene.display.light_direction = (0.6, 0.2, 0.77)
+    rng = np.random.default_rng(n * 7919 + len(look_name))
+    tmp = out / "_subframe.png"
+    for k, v in enumerate(VIEWS):
+        R = np.array(cams[v]["R"])
+        centre = -R.T @ np.array(cams[v]["t"])
+        scene.camera = add_camera(bpy, v, R, centre, WIDTH / PIXELS_PER_METRE)
+        back = backdrop_image(look.backdrop, seed=17 + k)
+        (out / v).mkdir(parents=True, exist_ok=True)
+        for f in range(n):
+            acc = np.zeros((HEIGHT, WIDTH, 3))
+            for s in range(look.blur):
+                sub = (s / look.blur - 0.5) * 0.5 if look.blur > 1 else 0.0  # half a frame
+                whole = int(np.floor(f + 1 + sub))
+                scene.frame_set(whole, subframe=f + 1 + sub - whole)
+                scene.render.filepath = str(tmp)
+                bpy.ops.render.render(write_still=True)
+                img = cv2.imread(str(tmp), cv2.IMREAD_UNCHANGED).astype(np.float32)
+                alpha = img[..., 3:] / 255
+                acc += img[..., :3] * alpha + back * (1 - alpha)
+            img = acc / look.blur + rng.normal(0, look.noise, acc.shape)
+            img = np.clip(img + 0.5, 0, 255).astype(np.uint8)
+            params = [cv2.IMWRITE_JPEG_QUALITY, look.jpeg] if look.jpeg else []
+            cv2.imwrite(str(out / v / f"{f:04d}.{ext}"), img, params)
+    tmp.unlink(missing_ok=True)
+    stamp.write_text(json.dumps(meta))
+    return n * len(VIEWS)

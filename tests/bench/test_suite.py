@@ -1,0 +1,109 @@
+"""The suite's captures of other namings and its cameras, against what each file says."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core import se3
+from core.bvh import read_bvh
+from core.skeleton import skeleton_from_bvh
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "bench"))
+
+from captures import CMU_UNIT, Parts, normalized  # noqa: E402
+from suite_footage import view_rotations  # noqa: E402
+
+# a small body in Bandai Namco's layout: a still joint_Root, Hips carrying the motion, and
+# position channels on every joint that repeat its offset (centimetres)
+_BN = """HIERARCHY
+ROOT joint_Root
+{
+  OFFSET 0 0 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Hips
+  {
+    OFFSET 1 90 -400
+    CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+    JOINT UpperLeg_L
+    {
+      OFFSET 10 0 0
+      CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+      End Site
+      {
+        OFFSET 40 0 0
+      }
+    }
+  }
+}
+MOTION
+Frames: 2
+Frame Time: 0.0333333
+0 0 0 0 0 0 1 90 -400 0 0 0 10 0 0 0 0 0
+0 0 0 0 0 0 3 91 -395 10 20 30 10 0 0 -30 15 45
+"""
+
+
+def test_a_bandai_namco_capture_becomes_one_moving_root_in_metres(tmp_path):
+    path = tmp_path / "bn.bvh"
+    path.write_text(_BN)
+    raw = read_bvh(path)
+    out = normalized(path)
+    assert out.names == ["Hips", "UpperLeg_L"] and len(out.motion) == 2
+    assert out.joints[1].channels == ["Zrotation", "Yrotation", "Xrotation"]
+    R_raw, _ = raw.poses()
+    R, root = out.poses()
+    np.testing.assert_allclose(root, [[0.01, 0.90, -4.00], [0.03, 0.91, -3.95]])
+    np.testing.assert_allclose(R, R_raw[:, 1:], atol=1e-9)
+    # the leg's end, worked out by hand from the file: Hips' position, its rotation applied
+    # to the leg's offset, the leg's rotation to its end site
+    sk = skeleton_from_bvh(out)
+    end = sk.joint_frames(R[1], root[1])[1]
+    tip = end[:3, :3] @ sk.end_sites[1][0] + end[:3, 3]
+    expect = (np.array([3, 91, -395]) + R_raw[1, 1] @ (np.array([10, 0, 0])
+                                                       + R_raw[1, 2] @ [40, 0, 0])) / 100
+    np.testing.assert_allclose(tip, expect, atol=1e-9)
+
+
+def test_a_motionbuilder_capture_is_read_in_metres():
+    out = normalized(ROOT / "bench" / "data" / "cmu05_01_walk.bvh")
+    raw = read_bvh(ROOT / "bench" / "data" / "cmu05_01_walk.bvh")
+    assert len(out.motion) == len(raw.motion) == 241
+    np.testing.assert_allclose(out.poses()[1], raw.poses()[1] * CMU_UNIT, atol=1e-9)
+    height = skeleton_from_bvh(out).height()
+    assert 1.4 < height < 2.0, height  # a person, in metres
+
+
+def test_each_hinge_is_about_the_axis_its_joint_turns_about_most():
+    """Knee turns about a known axis by 0..90 degrees with a little wobble: the hinge found
+    is that axis, signed so that the bend is positive."""
+    out = normalized(ROOT / "bench" / "data" / "cmu05_01_walk.bvh")
+    sk = skeleton_from_bvh(out)
+    parts = Parts.of(sk.names)
+    rng = np.random.default_rng(3)
+    axis = np.array([0.9, -0.3, 0.2]) / np.linalg.norm([0.9, -0.3, 0.2])
+    R = np.tile(np.eye(3), (40, sk.n_joints, 1, 1))
+    knee = sk.index(parts.roles["shank.L"])
+    for f, a in enumerate(np.radians(np.linspace(0, 90, 40))):
+        R[f, knee] = se3.exp_so3(-axis * a + rng.normal(0, 0.01, 3))
+    joints = parts.tracked_joints(sk, R, lower_back=False)
+    got = np.array(joints[parts.roles["shank.L"]]["axis"])
+    assert got @ -axis > 0.999
+    assert joints[parts.roles["thigh.L"]] == "ball"
+    assert parts.roles["lower_back"] not in joints
+
+
+@pytest.mark.parametrize("yaw", [0.0, 37.0, 200.0])
+def test_views_look_across_the_body_at_its_front_and_between(yaw):
+    lateral = se3.exp_so3([0, np.radians(yaw), 0]) @ [1.0, 0, 0]
+    rots = view_rotations(lateral)
+    forward = np.cross(lateral, [0, 1, 0])
+    for R in rots.values():
+        np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-12)
+        assert np.linalg.det(R) == pytest.approx(1.0)
+        assert R[1] @ [0, 1, 0] == pytest.approx(-1.0)  # image y down is world down
+    assert rots["lateral"][2] @ lateral == pytest.approx(1.0)
+    assert rots["endon"][2] @ forward == pytest.approx(-1.0)  # it walks toward the camera
+    assert rots["oblique60"][2] @ lateral == pytest.approx(0.5)
