@@ -5,9 +5,16 @@ tracking wrote and never a key the user set; where the user keyed a bone on a tr
 tracking leaves that bone's keys there alone (the frame is the user's correction, see
 ``user_keys``). A ball joint is keyed as a quaternion, a hinge as the one Euler channel of its
 free axis, the root bone as location and quaternion.
+
+Track keys its first frame too, as tracking's (the pose the user set there, so that the
+frame shows it after the run and a second Track starts from it again), and remembers the
+pose bones' own values from before the first Track on the armature (``POSE_BEFORE_TRACK``);
+clearing the track puts them back, so that the scene is as it was before Track.
 """
 
 from __future__ import annotations
+
+import json
 
 import numpy as np
 from mathutils import Matrix
@@ -17,6 +24,7 @@ from .bridge import armature_rotations, pose_from_armature
 
 TRACKED = "GENERATED"  # keyframe type of tracked keys
 USER = "KEYFRAME"  # keyframe type of a correction (Blender keeps a key's type when re-keyed)
+POSE_BEFORE_TRACK = "twist_pose_before_track"  # custom property of the armature object
 
 
 def channels(arm, sk: Skeleton) -> list[tuple[str, str, int]]:
@@ -93,9 +101,9 @@ def key_correction(arm, sk: Skeleton, frame: int) -> None:
                 kp.type = USER
 
 
-def user_keys(arm, sk: Skeleton) -> dict[int, frozenset[str]]:
+def user_keys(arm, sk: Skeleton, any_type: bool = False) -> dict[int, frozenset[str]]:
     """Per frame, the bones whose tracked channels hold a key the user set (any type but
-    GENERATED) there."""
+    GENERATED) there; with ``any_type``, any key."""
     bag = channelbag(arm)
     if bag is None:
         return {}
@@ -103,7 +111,7 @@ def user_keys(arm, sk: Skeleton) -> dict[int, frozenset[str]]:
     out: dict[int, set[str]] = {}
     for fc in tracked_fcurves(arm, sk, bag):
         for kp in fc.keyframe_points:
-            if kp.type != TRACKED:
+            if any_type or kp.type != TRACKED:
                 out.setdefault(int(round(kp.co[0])), set()).add(
                     bone_of[fc.data_path, fc.array_index])
     return {f: frozenset(bones) for f, bones in out.items()}
@@ -125,3 +133,30 @@ def clear(arm, sk: Skeleton, frames: set[int] | None = None) -> int:
         if not len(fc.keyframe_points):
             bag.fcurves.remove(fc)
     return removed
+
+
+def remember_pose(arm) -> None:
+    """Keep the pose bones' own values (rotation mode, location, rotations, scale) on the
+    armature, unless an earlier Track already kept them (then they are the user's, and the
+    current ones may be tracking's)."""
+    if POSE_BEFORE_TRACK in arm:
+        return
+    arm[POSE_BEFORE_TRACK] = json.dumps({pb.name: {
+        "rotation_mode": pb.rotation_mode, "location": list(pb.location),
+        "rotation_quaternion": list(pb.rotation_quaternion),
+        "rotation_euler": list(pb.rotation_euler), "scale": list(pb.scale)}
+        for pb in arm.pose.bones})
+
+
+def restore_pose(arm) -> None:
+    """Put back the pose bones' values ``remember_pose`` kept, and forget them."""
+    if POSE_BEFORE_TRACK not in arm:
+        return
+    for name, values in json.loads(arm[POSE_BEFORE_TRACK]).items():
+        pb = arm.pose.bones.get(name)
+        if pb is None:
+            continue
+        pb.rotation_mode = values.pop("rotation_mode")
+        for prop, v in values.items():
+            setattr(pb, prop, v)
+    del arm[POSE_BEFORE_TRACK]

@@ -95,7 +95,9 @@ def refine_armature(scene, only_selected: bool, planar: bool, rounds: int,
             progress(r + 1)
         if result.settled():
             break
-    keyframes.clear(arm, new_sk, set(session.frames[1:]))  # the last round kept
+    # tracking's keys of the range go (the first frame's too: the refined pose is set there,
+    # and Track keys it again); the user's stay
+    keyframes.clear(arm, new_sk, set(session.frames))
     return moves, stopped
 
 

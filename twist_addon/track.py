@@ -64,19 +64,32 @@ class TrackSession:
             views.append(view_from_camera(v.camera, scene))
             images.append(footage_frames(v, frames))
         sk = tracked_skeleton(arm)
-        R, root = pose_from_armature(arm, sk)
+        settings = settings_from_properties(tw.tracker)
+        # the tracker indexes frames 0..n-1 in tracking order
+        tracker = Tracker(sk, images, tw.mode.lower(), settings)
         user_keys = keyframes.user_keys(arm, sk)
         corrections = {}
         for i, f in enumerate(frames[1:], 1):
             if f in user_keys:
                 scene.frame_set(f)
                 corrections[i] = BodyPose(*pose_from_armature(arm, sk), views)
-        if corrections:
-            scene.frame_set(cur)
-        settings = settings_from_properties(tw.tracker)
-        # the tracker indexes frames 0..n-1 in tracking order
-        tracker = Tracker(sk, images, tw.mode.lower(), settings)
+        scene.frame_set(cur)
+        R, root = pose_from_armature(arm, sk)
         return cls(arm, frames, tracker, BodyPose(R, root, views), user_keys, corrections)
+
+    def keep_start_pose(self, scene) -> None:
+        """Key the first frame's pose (the user's) there, on the bones with no key there yet,
+        and start from it as read back from those keys: the frame shows the user's pose
+        after the run, and a second Track from it starts from the very same (float32) pose.
+        The pose bones' own values are remembered for Clear Track."""
+        arm, sk, cur = self.armature, self.tracker.given_skeleton, self.frames[0]
+        keyframes.remember_pose(arm)
+        keyed = keyframes.user_keys(arm, sk, any_type=True).get(cur, frozenset())
+        keyframes.write_pose(arm, sk, cur, self.initial.rotations, self.initial.root_position,
+                             keyed)
+        scene.frame_set(cur)
+        R, root = pose_from_armature(arm, sk)
+        self.initial = BodyPose(R, root, self.initial.views)
 
     def run(self):
         """Yield after each frame is tracked and keyed."""
@@ -133,6 +146,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
         except INPUT_ERRORS as e:
             self.report({"ERROR"}, str(e))
             return False
+        self._session.keep_start_pose(context.scene)
         self._steps = self._session.run()
         return True
 
@@ -216,7 +230,8 @@ class TWIST_OT_key_correction(ArmatureAction, bpy.types.Operator):
 
 
 class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
-    """Remove the keyframes tracking wrote on the armature, and no other"""
+    """Remove the keyframes tracking wrote on the armature, and no other, and give the bones
+    back the pose they had before Track"""
 
     bl_idname = "twist.clear_track"
     bl_label = "Clear Track"
@@ -224,6 +239,8 @@ class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
     def run(self, context) -> str:
         arm = context.scene.twist.armature
         n = keyframes.clear(arm, skeleton_from_armature(arm))
+        keyframes.restore_pose(arm)
+        context.scene.frame_set(context.scene.frame_current)  # user keys decide where left
         return f"removed {n} tracked keyframes from '{arm.name}'"
 
 

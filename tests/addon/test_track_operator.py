@@ -61,8 +61,8 @@ def test_track_keys_exactly_the_tracked_bones_and_frames(bpy_module, registered,
     keys = _channel_frames(arm)
     root = arm.data.bones[0].name
     assert set(keys) == set(TRACKED) | {root, "LeftCollar"}
-    for bone in TRACKED + [root]:
-        assert keys[bone] == {(f, "GENERATED") for f in range(2, 7)}, bone
+    for bone in TRACKED + [root]:  # the first frame keeps the user's pose, as tracking's key
+        assert keys[bone] == {(f, "GENERATED") for f in range(1, 7)}, bone
     assert keys["LeftCollar"] == {(3, "KEYFRAME")}
     # the tracked legs follow the capture
     bridge = registered.twist_addon.bridge
@@ -134,7 +134,7 @@ def test_one_view_tracked_side_on_keys_turns_about_the_line_of_sight(bpy_module,
             turned += np.linalg.norm(w) > 0.01
     assert turned > 5  # the bones did turn
     keyed = _channel_frames(arm)
-    assert all(keyed[b] == {(f, "GENERATED") for f in range(2, 5)} for b in TRACKED)
+    assert all(keyed[b] == {(f, "GENERATED") for f in range(1, 5)} for b in TRACKED)
 
 
 def _quaternions(addon, arm, bones, frame):
@@ -217,6 +217,50 @@ def test_key_correction_keys_every_tracked_bone_as_the_users(bpy_module, registe
     layout = Recorder()
     addon.track.draw_pose_menu_entry(types.SimpleNamespace(layout=layout), bpy.context)
     assert ("operator", ("twist.key_correction",)) in [(n, a) for n, a, _ in layout.calls]
+
+
+def _pose_values(arm):
+    """Every pose bone's own values, as the scene holds them at the current frame."""
+    return {pb.name: (pb.rotation_mode, *(tuple(round(x, 5) for x in v) for v in (
+        pb.location, pb.rotation_quaternion, pb.rotation_euler, pb.scale)))
+        for pb in arm.pose.bones}
+
+
+def _all_keys(addon, arm):
+    bag = addon.twist_addon.keyframes.channelbag(arm)
+    return {(fc.data_path, fc.array_index): np.array([k.co for k in fc.keyframe_points])
+            for fc in bag.fcurves}
+
+
+def test_track_twice_and_clear_never_move_the_users_pose(bpy_module, registered, footage):
+    """The user's pose on the first frame stays as set after Track; a second Track from that
+    frame writes the same keys as the first; Clear Track leaves the bones as before Track."""
+    bpy = bpy_module
+    scene, arm = _scene(bpy, registered, footage)
+    before = _pose_values(arm)
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    scene.frame_set(1)
+    bridge = registered.twist_addon.bridge
+    sk = bridge.tracked_skeleton(arm)
+    arm_before = bridge.pose_from_armature  # the start pose, read as Track reads it
+    first_keys = _all_keys(registered, arm)
+    R1, p1 = arm_before(arm, sk)
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    scene.frame_set(1)
+    R2, p2 = arm_before(arm, sk)
+    np.testing.assert_array_equal(R2, R1)  # the very same start
+    np.testing.assert_array_equal(p2, p1)
+    again = _all_keys(registered, arm)
+    assert again.keys() == first_keys.keys()
+    for k in again:
+        np.testing.assert_array_equal(again[k], first_keys[k], err_msg=str(k))
+    scene.frame_set(4)
+    assert bpy.ops.twist.clear_track() == {"FINISHED"}
+    assert arm.animation_data.action is None or not len(
+        registered.twist_addon.keyframes.channelbag(arm).fcurves)
+    for f in (1, 4):
+        scene.frame_set(f)
+        assert _pose_values(arm) == before, f
 
 
 def _bvh_world(bvh, R, p):
