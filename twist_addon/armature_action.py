@@ -15,7 +15,10 @@ class ArmatureAction:
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None and context.scene.twist.armature is not None
+        if context.scene is not None and context.scene.twist.armature is not None:
+            return True
+        cls.poll_message_set("Set the armature to track first (Twist Mocap > Armature)")
+        return False
 
     def execute(self, context):
         try:

@@ -63,6 +63,21 @@ class TWIST_OT_add_view(bpy.types.Operator):
             return {"CANCELLED"}
         movie = is_video(path)
         pattern = str(path) if movie else str(path.parent / f"*{path.suffix}")
+        try:
+            if movie:
+                source = bpy.data.movieclips.load(str(path), check_existing=True)
+                count, (img_w, img_h) = source.frame_duration, source.size
+                if not count:
+                    bpy.data.movieclips.remove(source)
+                    raise RuntimeError("no frames")
+            else:
+                count = len(glob.glob(pattern))
+                source = bpy.data.images.load(str(path), check_existing=True)
+                img_w, img_h = source.size  # a sequence reports no size until it is shown
+        except RuntimeError:
+            self.report({"ERROR"}, f"{path.name}: Blender cannot read it as a movie or an "
+                        "image; pick a movie file or any image of an image sequence")
+            return {"CANCELLED"}
         scene = context.scene
         n = len(scene.twist.views) + 1
         cam_data = bpy.data.cameras.new(f"View {n}")
@@ -75,16 +90,11 @@ class TWIST_OT_add_view(bpy.types.Operator):
         bg = cam_data.background_images.new()
         bg.frame_method = "FIT"
         if movie:
-            clip = bpy.data.movieclips.load(str(path), check_existing=True)
-            clip.frame_start = self.first_frame
-            bg.source, bg.clip = "MOVIE_CLIP", clip
-            count, (img_w, img_h) = clip.frame_duration, clip.size
+            source.frame_start = self.first_frame
+            bg.source, bg.clip = "MOVIE_CLIP", source
         else:
-            count = len(glob.glob(pattern))
-            image = bpy.data.images.load(str(path), check_existing=True)
-            img_w, img_h = image.size  # a sequence reports no size until it is shown
-            image.source = "SEQUENCE" if count > 1 else "FILE"
-            bg.image = image
+            source.source = "SEQUENCE" if count > 1 else "FILE"
+            bg.image = source
             bg.image_user.frame_start = self.first_frame
             bg.image_user.frame_duration = count
         if img_w and img_h and n == 1:
@@ -94,7 +104,15 @@ class TWIST_OT_add_view(bpy.types.Operator):
         view.images = bpy.path.relpath(pattern) if bpy.data.filepath else pattern
         view.first_frame = self.first_frame
         scene.twist.active_view = len(scene.twist.views) - 1
-        self.report({"INFO"}, f"added '{cam.name}' with {count} frames")
+        last = self.first_frame + count - 1
+        message = f"added '{cam.name}' with {count} frames"
+        if n == 1:  # the scene's range is the footage's
+            scene.frame_start, scene.frame_end = self.first_frame, last
+            message += f"; the scene's frames are now {self.first_frame}-{last}"
+        elif scene.frame_end > last:  # every view must have an image for every frame
+            scene.frame_end = max(last, scene.frame_start)
+            message += f"; the scene now ends at frame {scene.frame_end}, where its footage does"
+        self.report({"INFO"}, message)
         return {"FINISHED"}
 
 

@@ -54,6 +54,13 @@ def test_add_and_remove_views(bpy_module, registered, tmp_path):
     assert bg.image.source == "SEQUENCE" and bg.image_user.frame_duration == 4
     assert (scene.render.resolution_x, scene.render.resolution_y) == (40, 30)
     assert view.images.endswith("*.png")
+    assert (scene.frame_start, scene.frame_end) == (5, 8)  # the footage's frames
+    for i in range(3):  # a second view whose footage ends sooner shortens the scene
+        cv2.imwrite(str(tmp_path / f"end_{i:04d}.jpg"), np.zeros((30, 40, 3), np.uint8))
+    assert bpy.ops.twist.add_view(filepath=str(tmp_path / "end_0000.jpg"),
+                                  first_frame=5) == {"FINISHED"}
+    assert (scene.frame_start, scene.frame_end) == (5, 7)
+    assert bpy.ops.twist.remove_view() == {"FINISHED"}
     with pytest.raises(RuntimeError, match="missing.png: no such image or movie file"):
         bpy.ops.twist.add_view(filepath=str(tmp_path / "missing.png"))
     assert bpy.ops.twist.remove_view() == {"FINISHED"}
@@ -80,3 +87,22 @@ def test_a_movie_becomes_a_view_with_the_clip_behind_its_camera(bpy_module, regi
     assert [int(round(frames[k].mean() / 30)) for k in range(3)] == [1, 5, 0]
     with pytest.raises(registered.twist_addon.bridge.BridgeError, match="no image for frame 9"):
         views.footage_frames(view, [9])
+
+
+def test_a_file_that_is_no_movie_is_refused_before_anything_is_made(bpy_module, registered,
+                                                                    tmp_path):
+    bpy = bpy_module
+    fake = tmp_path / "holiday.mp4"
+    fake.write_bytes(b"not a movie at all" * 100)
+    cameras = len(bpy.data.objects)
+    with pytest.raises(RuntimeError, match="holiday.mp4: Blender cannot read it as a movie"):
+        bpy.ops.twist.add_view(filepath=str(fake))
+    assert len(bpy.context.scene.twist.views) == 0 and len(bpy.data.objects) == cameras
+    assert not bpy.data.movieclips
+
+
+def test_track_without_an_armature_says_why_it_cannot_run(bpy_module, registered):
+    bpy = bpy_module
+    assert not bpy.ops.twist.track.poll()
+    with pytest.raises(RuntimeError, match="Set the armature to track first"):
+        bpy.ops.twist.track()
