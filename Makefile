@@ -8,10 +8,16 @@ STAMP := $(VENV)/.installed
 
 venv: $(STAMP)
 
+# Blender 5.0 runs Python 3.11, and its bpy module installs on 3.11 only. A set-up that
+# fails leaves no .venv behind, so the next make starts afresh.
 $(STAMP): requirements.txt
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' 2>/dev/null || { \
+	  echo "twist-mocap needs Python 3.11 (Blender 5.0's); '$(PYTHON)' is not. Run with one:" \
+	       "make PYTHON=python3.11 $(MAKECMDGOALS)" >&2; exit 1; }
+	rm -rf $(VENV)
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -r requirements.txt
+	$(PY) -m pip install --quiet --upgrade pip || { rm -rf $(VENV); exit 1; }
+	$(PY) -m pip install --quiet -r requirements.txt || { rm -rf $(VENV); exit 1; }
 	touch $(STAMP)
 
 # Track the bundled example through the add-on: tracked .blend, BVH, FBX, contact sheet.
@@ -42,5 +48,6 @@ bench-walk: venv
 extension: venv
 	$(PY) scripts/build_extension.py
 
+# Everything the build and the runs made: footage, exports, wheels and the environment.
 clean:
-	rm -rf .cache dist .pytest_cache
+	rm -rf .cache dist wheels .pytest_cache .ruff_cache $(VENV)
