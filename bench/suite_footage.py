@@ -3,9 +3,10 @@ looks that vary what real footage varies.
 
 A look sets the body's cloth (its texture and its contrast with what is behind it), the
 backdrop (Muybridge's ruled black, a bright brick wall, a busy park-like scene), the light
-(soft studio, or hard sun with shadows on the body), motion blur (sub-frames averaged over
-half the frame interval), sensor noise and JPEG compression. The body is the same skinned
-capsule body as the walk benchmark's (``walk_footage``), sized by the capture's parts.
+(soft studio, or hard sun casting the body's shadow on the wall beside it), motion blur
+(sub-frames averaged over half the frame interval), sensor noise and JPEG compression. The
+body is the same skinned capsule body as the walk benchmark's (``walk_footage``), sized by
+the capture's parts.
 
 Footage is rendered at 30 frames per second (15 fps runs take every other frame) into
 ``<clip folder>/<look folder>/<view>/NNNN.png|jpg`` (frames from 0), with ``truth.bvh``
@@ -36,7 +37,7 @@ VIEWS = ("lateral", "endon", "oblique60")
 class Look:
     cloth: str  # "woven" (blotchy weave), "plain" (one light colour), "stripes" (dark/light)
     backdrop: str  # "ruled" (dark, light lines), "bricks" (a bright wall), "park" (busy)
-    light: str  # "studio" (soft) or "sun" (hard, with shadows)
+    light: str  # "studio" (soft) or "sun" (hard: the body's shadow falls on the backdrop)
     blur: int  # sub-frames averaged per frame (1: no motion blur)
     noise: float  # sensor noise, grey levels of 255
     jpeg: int  # JPEG quality (0: lossless PNG)
@@ -94,6 +95,23 @@ def backdrop_image(kind: str, seed: int) -> np.ndarray:
         img[ground] = (90.0, 130.0, 150.0) + 15 * rng.normal(size=(int(ground.sum()), WIDTH, 3))
         return img
     raise ValueError(f"no backdrop '{kind}'")
+
+
+SHADOW_OFFSET = (22, 8)  # pixels the sun's shadow of the body falls right and down of it
+SHADOW_DEPTH = 0.55  # share of the backdrop's light the shadow takes away
+
+
+def cast_shadow(alpha: np.ndarray) -> np.ndarray:
+    """The body's shadow on the wall behind it (H, W, 1) in [0, 1]: its coverage ``alpha``
+    (H, W, 1) moved by ``SHADOW_OFFSET``, its edge softened over a pixel (a hard sun).
+    Rendering Workbench's own shadows costs 2.5 s a frame without a GPU; on a flat wall
+    square to the camera a shadow is this shift."""
+    import cv2
+
+    dx, dy = SHADOW_OFFSET
+    moved = np.zeros_like(alpha[..., 0])
+    moved[dy:, dx:] = alpha[:-dy, :-dx, 0]
+    return cv2.GaussianBlur(moved, (3, 3), 0.8)[..., None]
 
 
 def cloth(kind: str, P: np.ndarray) -> np.ndarray:
@@ -177,11 +195,6 @@ def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
     body.data.color_attributes["cloth"].data.foreach_set("color",
                                                          rgba.astype(np.float32).ravel())
     scene = bpy.context.scene
-    if look.light == "sun":
-        scene.display.shading.show_shadows = True
-        scene.display.shadow_shift = 0.1
-        scene.display.shading.shadow_intensity = 0.7
-        scene.display.light_direction = (0.6, 0.2, 0.77)
     rng = np.random.default_rng(n * 7919 + len(look_name))
     tmp = out / "_subframe.png"
     for k, v in enumerate(VIEWS):
@@ -200,7 +213,9 @@ def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
                 bpy.ops.render.render(write_still=True)
                 img = cv2.imread(str(tmp), cv2.IMREAD_UNCHANGED).astype(np.float32)
                 alpha = img[..., 3:] / 255
-                acc += img[..., :3] * alpha + back * (1 - alpha)
+                wall = back * (1 - SHADOW_DEPTH * cast_shadow(alpha)) if look.light == "sun" \
+                    else back
+                acc += img[..., :3] * alpha + wall * (1 - alpha)
             img = acc / look.blur + rng.normal(0, look.noise, acc.shape)
             img = np.clip(img + 0.5, 0, 255).astype(np.uint8)
             params = [cv2.IMWRITE_JPEG_QUALITY, look.jpeg] if look.jpeg else []
