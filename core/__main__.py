@@ -1,9 +1,12 @@
-"""Command line:
+"""twist-mocap's tracker without Blender: footage of a moving body in, a BVH out.
 
-    python -m core track JOB.json --out TRACKED.bvh [--report REPORT.json]
-    python -m core fit FIT.json --out FITTED.bvh
+    twist-mocap track JOB.json --out TRACKED.bvh [--report REPORT.json]
+    twist-mocap fit FIT.json --out FITTED.bvh
 
-Exit status: 0 done; 2 the job is malformed or the clicks cannot determine a fit (nothing
+(``python -m core`` with the project's Python does the same.) A job names the body (a BVH
+and the joints to track), the first frame's pose, each view's footage and camera, and
+settings; docs/JOB_FORMAT.md describes every field. Exit status: 0 done; 2 the job, its
+footage or the output paths are unusable, or the clicks cannot determine a fit (nothing
 written); 3 tracking stopped at a diverged frame (the frames before it are written).
 """
 
@@ -11,7 +14,9 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import sys
+from pathlib import Path
 
 from .bvh import write_bvh
 from .image import ImageError
@@ -21,7 +26,22 @@ from .pose import world_pose
 from .run import report, result_bvh, timed_run, write_report
 
 
+def _writable(path: str, what: str) -> str:
+    """'' when ``path`` can be written, else why not (checked before any work is done)."""
+    folder = Path(path).resolve().parent
+    if not folder.is_dir():
+        return f"the folder of the {what} ({folder}) does not exist: create it, or name another"
+    if not os.access(folder, os.W_OK):
+        return f"the {what} cannot be written into {folder} (no permission)"
+    return ""
+
+
 def _track(args) -> int:
+    problems = [p for p in (_writable(args.out, "output BVH"),
+                            args.report and _writable(args.report, "report")) if p]
+    if problems:
+        print(f"error: {problems[0]}", file=sys.stderr)
+        return 2
     try:
         job = load_job(args.job)
     except JobError as e:
@@ -44,9 +64,9 @@ def _track(args) -> int:
         write_report(args.report, report(job, result, seconds))
     for note in result.notes:
         print(f"note: {note}", file=sys.stderr)
-    n = len(result.frames)
-    print(f"tracked {n} of {len(job.images[0])} frames in {seconds:.1f} s -> {args.out}",
-          file=sys.stderr)
+    rep = report(job, result, seconds)
+    print(f"tracked {rep['frames_tracked']} of {rep['frames_total']} frames after the first"
+          f" in {seconds:.1f} s -> {args.out}", file=sys.stderr)
     if result.diverged_frames:
         f = result.diverged_frames[0]
         print(f"stopped: frame {f} diverged ({result.frames[-1].reason}); correct the pose"
@@ -56,6 +76,10 @@ def _track(args) -> int:
 
 
 def _fit(args) -> int:
+    problem = _writable(args.out, "fitted BVH")
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
     try:
         job = load_fit(args.job)
         res = fit_pose(job.skeleton, job.guess, job.clicks, job.mode, job.fit_lengths)
@@ -74,7 +98,8 @@ def _fit(args) -> int:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m core", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="twist-mocap", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="command", required=True)
     t = sub.add_parser("track", help="track a job's footage and write a BVH")
     t.add_argument("job", help="the job file (JSON)")

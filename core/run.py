@@ -27,9 +27,10 @@ def run_job(
 
 
 def result_bvh(job: Job, result: TrackResult):
-    """The job's BVH hierarchy holding one frame per tracked frame."""
+    """The job's BVH hierarchy holding one frame per tracked frame (a diverged frame's pose
+    is not kept: the add-on does not key it either)."""
     rots, roots = [], []
-    for fr in result.frames:
+    for fr in (f for f in result.frames if not f.diverged):
         R, p0 = world_pose(job.mode, job.cameras[0], fr.pose)
         rots.append(R)
         roots.append(p0)
@@ -39,15 +40,18 @@ def result_bvh(job: Job, result: TrackResult):
 
 
 def report(job: Job, result: TrackResult, seconds: float) -> dict:
-    """Per-frame residual, iterations, convergence and timing, with a summary."""
+    """Per-frame residual, iterations, convergence and timing, with a summary. Frames are
+    counted as the add-on counts them: those after the first (the user's pose), tracked
+    without diverging, of those there are. Numbers that are not (a diverged frame's
+    residual) are null, so that the report is strict JSON."""
     tracked = result.frames[1:]
     iters = sum(f.iterations for f in tracked)
     return {
         "mode": job.mode,
         "views": len(job.images),
         "degrees_of_freedom": len(job.skeleton.dof_names()),
-        "frames_total": len(job.images[0]),
-        "frames_tracked": len(result.frames),
+        "frames_total": len(job.images[0]) - 1,
+        "frames_tracked": sum(not f.diverged for f in tracked),
         "cancelled": result.cancelled,
         "diverged_frames": result.diverged_frames,
         "notes": result.notes,
@@ -57,7 +61,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
         "frames": [
             {
                 "frame": f.frame,
-                "residual": f.residual,
+                "residual": f.residual if np.isfinite(f.residual) else None,
                 "iterations": f.iterations,
                 "converged": f.converged,
                 "diverged": f.diverged,
@@ -71,7 +75,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
 
 
 def write_report(path: str | Path, rep: dict) -> None:
-    Path(path).write_text(json.dumps(rep, indent=1, allow_nan=True))
+    Path(path).write_text(json.dumps(rep, indent=1, allow_nan=False))
 
 
 def timed_run(job: Job, progress=None, cancel=None) -> tuple[TrackResult, float]:

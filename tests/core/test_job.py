@@ -90,8 +90,45 @@ def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path, mode):
     np.testing.assert_allclose(R_got[:, untracked], np.repeat(R_true[:1, untracked], 3, 0),
                                atol=1e-5)
     report = json.loads(rep.read_text())
-    assert report["frames_tracked"] == 3 and report["diverged_frames"] == []
+    assert report["frames_tracked"] == report["frames_total"] == 2  # after the first
+    assert report["diverged_frames"] == []
     assert {"frame", "residual", "iterations", "converged", "seconds"} <= set(report["frames"][1])
+
+
+@pytest.mark.parametrize("flag", ["--out", "--report"])
+def test_an_output_folder_that_does_not_exist_stops_the_run_before_it_starts(footage,
+                                                                           tmp_path, flag):
+    folder, _ = footage
+    paths = {"--out": tmp_path / "out.bvh", "--report": tmp_path / "report.json"}
+    paths[flag] = tmp_path / "missing" / paths[flag].name
+    proc = _run("track", folder / "job.json", "--out", paths["--out"], "--report",
+                paths["--report"])
+    assert proc.returncode == 2
+    assert f"({tmp_path / 'missing'}) does not exist" in proc.stderr
+    assert "frame" not in proc.stderr and not any(tmp_path.iterdir())  # nothing tracked
+
+
+def test_a_diverged_runs_report_is_strict_json(footage, tmp_path):
+    """Every frame flagged (the body must stay more than wholly inside the images): the run
+    stops at frame 1, writes frame 0, and its report has null where a residual is none."""
+    folder, job = footage
+    job_path = folder / "job_diverges.json"
+    job_path.write_text(json.dumps(dict(job, settings={"min_inside": 1.5})))
+    out, rep = tmp_path / "out.bvh", tmp_path / "report.json"
+    proc = _run("track", job_path, "--out", out, "--report", rep)
+    assert proc.returncode == 3, proc.stderr
+    assert "tracked 0 of 2 frames after the first" in proc.stderr
+    report = json.loads(rep.read_text(), parse_constant=lambda c: pytest.fail(c))
+    assert report["frames"][1]["residual"] is None and report["diverged_frames"] == [1]
+    assert len(read_bvh(out).motion) == 1
+
+
+def test_the_command_line_says_what_it_does_and_runs_from_any_folder(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "core", "--help"], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "footage of a moving body in, a BVH out" in proc.stdout
+    assert "JOB_FORMAT.md" in proc.stdout and "track" in proc.stdout and "fit" in proc.stdout
 
 
 def test_a_corrected_frame_takes_its_given_pose_and_the_others_are_tracked(footage, tmp_path):
