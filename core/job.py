@@ -1,34 +1,9 @@
-"""The tracking job: a JSON file naming the skeleton, the initial pose, the views and the mode.
+"""The tracking job: a JSON file naming the skeleton, the initial pose, the views and the mode,
+read and checked here, each error naming the field and what it expects.
 
-This format is a public contract (``python -m core track JOB.json``): fields may be added,
-never removed or changed in meaning. Relative paths are relative to the job file's folder.
-
-.. code-block:: json
-
-    {"skeleton": {"bvh": "body.bvh",
-                  "joints": {"LeftHip": "ball",
-                             "LeftKnee": {"kind": "hinge", "axis": [1, 0, 0],
-                                          "limits": [0, 150]}},
-                  "blobs": {"Chest": {"radius": 0.12}, "LeftCollar": false}},
-     "initial": {"bvh": "body.bvh", "frame": 0},
-     "corrections": [{"image": 30, "bvh": "fixed.bvh", "frame": 0}],
-     "views": [{"images": "lateral/*.png",
-                "camera": {"model": "scaled_orthographic", "R": [[1,0,0],[0,1,0],[0,0,1]],
-                           "t": [0, 0, 0], "scale": 100, "center": [240, 180]}}],
-     "mode": "calibrated",
-     "settings": {"levels": 3},
-     "frame_time": 0.0667}
-
-A view's ``images`` are a glob, a list of image files or one movie file (.mp4, .mov, .avi...).
-A camera maps a world point X (the BVH's units) to pixel = scale * (R X + t)[:2] + center,
-x right, y down. Joints not named under ``joints`` keep their initial rotation; a hinge's
-optional ``limits`` bound its angle in degrees (the rotation vector's component along the
-axis, 0 at the BVH's rest pose), so that the tracker never bends it backwards. A blob entry
-sets the short radius (``radius``, or two ``radii``) and optionally the full ``length`` along
-the bone (centred on the bone) of every blob of that joint, or is ``false`` to drop them.
-Optional ``corrections`` give the pose at later frames (``image``: the index of the footage
-frame, 1 or more; the pose as a frame of a BVH with the skeleton's hierarchy): such a frame
-is not tracked but takes that pose, and the frames after it are held against it.
+The format is a public contract, described field by field in ``docs/JOB_FORMAT.md``
+(``python -m core track JOB.json``; ``fit`` adds ``clicks``): fields may be added, never
+removed or changed in meaning. Relative paths are relative to the job file's folder.
 """
 
 from __future__ import annotations
