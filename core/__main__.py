@@ -93,7 +93,8 @@ def _fit(args) -> int:
     write_bvh(out, args.out)
     print(f"fitted {sum(len(c) for c in job.clicks)} clicks, {res.residual_px:.2f} px RMS"
           f" -> {args.out}", file=sys.stderr)
-    print(f"least certain bones: {least_certain(res.direction_uncertainty)}", file=sys.stderr)
+    said = least_certain(res.direction_uncertainty, views=len(job.cameras))
+    print(f"least certain bones: {said}", file=sys.stderr)
     return 0
 
 

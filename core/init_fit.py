@@ -163,13 +163,22 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
                          bones_turned, _direction_sd(bone_points, sol.x, cov, bones_turned))})
 
 
-def least_certain(uncertainty: dict[str, float], n: int = 3) -> str:
-    """The ``n`` bones whose directions the clicks pin least, for a message:
-    'LeftElbow +-1.8, Neck +-1.6 degrees per pixel of click error'."""
-    worst = sorted(uncertainty.items(), key=lambda kv: -kv[1])[:n]
-    text = ", ".join(f"{name} " + ("not pinned" if sd >= 180 else f"+-{sd:.1f}")
-                     for name, sd in worst)
-    return f"{text} degrees per pixel of click error" if worst else "none turned"
+def least_certain(uncertainty: dict[str, float], n: int = 3, views: int = 2) -> str:
+    """For a message: the ``n`` bones whose directions the clicks pin least, then those they
+    do not pin at all, e.g. 'LeftElbow +-1.8, Neck +-1.6 degrees per pixel of click error;
+    not pinned: LeftKnee (...)'. With one view, what is not pinned is a turn toward or away
+    from the camera, which its clicks show only as foreshortening."""
+    free = sorted(name for name, sd in uncertainty.items() if sd >= 180)
+    pinned = sorted(((k, v) for k, v in uncertainty.items() if v < 180), key=lambda kv: -kv[1])
+    parts = []
+    if pinned:
+        parts.append(", ".join(f"{k} +-{v:.1f}" for k, v in pinned[:n])
+                     + " degrees per pixel of click error")
+    if free:
+        why = ("its turn toward or away from the camera: one view shows it only as "
+               "foreshortening" if views == 1 else "click the joints below it in a view")
+        parts.append(f"not pinned: {', '.join(free)} ({why})")
+    return "; ".join(parts) or "none turned"
 
 
 def _turned_bones(sk: Skeleton, joints: list[int]) -> list[tuple[int, int]]:

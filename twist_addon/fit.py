@@ -111,7 +111,7 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
         sk = skeleton_from_armature(arm)
     R_fit, root_fit = world_pose(mode, views[0], res.pose)
     set_pose(arm, sk, R_fit, root_fit)
-    return res.residual_px, changed, least_certain(res.direction_uncertainty)
+    return res.residual_px, changed, least_certain(res.direction_uncertainty, views=len(views))
 
 
 class TWIST_OT_import_markers(ArmatureAction, bpy.types.Operator):

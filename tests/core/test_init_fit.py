@@ -8,7 +8,7 @@ import pytest
 from core import se3
 from core.bvh import read_bvh
 from core.camera import View
-from core.init_fit import FitError, fit_pose, symmetry_key
+from core.init_fit import FitError, fit_pose, least_certain, symmetry_key
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose
 from core.skeleton import BALL, HINGE, Skeleton, skeleton_from_bvh
 
@@ -285,12 +285,25 @@ def test_the_fit_command_writes_fitted_offsets_and_pose(cmu_walk, tmp_path):
     assert "bad.json.clicks: expected one object per view (3), got 2" in proc.stderr
     one = dict(fit, views=fit["views"][:1], clicks=fit["clicks"][:1])
     for name, extra, code, says in [("one.json", {}, 2, "one view cannot tell a longer bone"),
-                                    ("pose.json", {"fit_lengths": False}, 0, "not pinned")]:
+                                    ("pose.json", {"fit_lengths": False}, 0,
+                                     "(its turn toward or away from the camera: one view "
+                                     "shows it only as foreshortening)")]:
         (tmp_path / name).write_text(json.dumps(dict(one, **extra)))
         proc = subprocess.run([sys.executable, "-m", "core", "fit", str(tmp_path / name),
                                "--out", str(tmp_path / "x.bvh")], cwd=root,
                               capture_output=True, text=True)
         assert proc.returncode == code and says in proc.stderr + proc.stdout, proc.stderr
+
+
+def test_the_least_certain_bones_are_named_apart_from_those_not_pinned():
+    said = least_certain({"Neck": 2.13, "LeftElbow": 1.9, "LeftKnee": 0.4, "RightHip": 1e9,
+                          "LeftShoulder": 180.0}, n=2, views=1)
+    assert said == ("Neck +-2.1, LeftElbow +-1.9 degrees per pixel of click error; not "
+                    "pinned: LeftShoulder, RightHip (its turn toward or away from the camera:"
+                    " one view shows it only as foreshortening)")
+    assert least_certain({"Neck": 1e9}) == ("not pinned: Neck (click the joints below it in "
+                                            "a view)")
+    assert least_certain({}) == "none turned"
 
 
 def test_degenerate_clicks_get_a_clear_message(cmu_walk):
