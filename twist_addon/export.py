@@ -4,6 +4,9 @@ active object is not one, the scene's tracked armature) over the scene's frame r
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import bpy
 from bpy_extras.io_utils import ExportHelper
 
@@ -39,6 +42,21 @@ def _frame_range(arm, scene, only_cycle: bool) -> tuple[int, int]:
 
 
 
+def _check_path(filepath: str, ext: str) -> None:
+    """BridgeError unless ``filepath`` names a file in a folder that exists and can be
+    written (checked before the scene is touched)."""
+    if not filepath:
+        raise BridgeError(f"no file to export to: give a file path ending in {ext}")
+    path = Path(bpy.path.abspath(filepath))
+    if path.is_dir() or not path.name:
+        raise BridgeError(f"{filepath} is a folder: give a file name ending in {ext}")
+    if not path.parent.is_dir():
+        raise BridgeError(f"the folder {path.parent} does not exist: create it, or export "
+                          "to another")
+    if not os.access(path.parent, os.W_OK):
+        raise BridgeError(f"cannot write into {path.parent} (no permission)")
+
+
 def _select_only(context, obj) -> None:
     if context.object and context.object.mode != "OBJECT":
         bpy.ops.object.mode_set(mode="OBJECT")
@@ -70,6 +88,7 @@ class _Export(ExportHelper):
                         "Armature")
             return {"CANCELLED"}
         try:
+            _check_path(self.filepath, self.filename_ext)
             first, last = _frame_range(arm, context.scene, self.only_cycle)
         except BridgeError as e:
             self.report({"ERROR"}, str(e))

@@ -1,6 +1,8 @@
 """Export round trips: the tracked armature's motion written by twist.export_bvh / export_fbx,
 read back by Blender's importers and by a reader that shares no code with the exporter."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -183,3 +185,17 @@ def test_export_acts_on_the_active_armature_else_the_tracked_one(bpy_module, reg
     assert bpy.ops.twist.export_bvh(filepath=str(out), armature=walker.name) == {"FINISHED"}
     assert bpy.context.view_layer.objects.active == human  # the selection is left as it was
     assert human.select_get() and not walker.select_get()
+
+
+@pytest.mark.parametrize("op", ["export_bvh", "export_fbx"])
+def test_an_export_with_nowhere_to_go_says_so_and_changes_nothing(animated, tmp_path, op):
+    bpy, scene, arm, _, _ = animated
+    ext = op[-3:]
+    selected = [o.name for o in bpy.context.view_layer.objects if o.select_get()]
+    for path, says in [("", f"no file to export to: give a file path ending in .{ext}"),
+                       (str(tmp_path / "no" / f"walk.{ext}"),
+                        f"the folder {tmp_path / 'no'} does not exist")]:
+        with pytest.raises(RuntimeError, match=re.escape(says)):
+            getattr(bpy.ops.twist, op)(filepath=path)
+    assert [o.name for o in bpy.context.view_layer.objects if o.select_get()] == selected
+    assert not (tmp_path / "no").exists()
