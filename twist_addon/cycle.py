@@ -129,11 +129,16 @@ def _continuous_quaternions(values: np.ndarray, curves: list) -> None:
             values[:, cols] = continuous_quaternions(values[:, cols])
 
 
+MIN_GAIT_SECONDS = 0.5  # no gait repeats faster: a period found shorter is not a gait's
+
+
 def make_cycle(arm, first: int, last: int, period: float | None = None,
-               blend: int = 4, in_place: bool = True, mirror: bool = False) -> tuple[int, int]:
+               blend: int = 4, in_place: bool = True, mirror: bool = False,
+               fps: float = 24.0) -> tuple[int, int]:
     """Turn the tracked channels of ``arm`` over frames first..last into one looping cycle.
 
-    The period (frames) is found from the tracked channels unless given; the cycle is the last
+    The period (frames) is found from the tracked channels unless given (a period under
+    ``MIN_GAIT_SECONDS`` at ``fps`` is taken as not found); the cycle is the last
     full period of the range, or with ``mirror`` the period from ``first`` on, its frames past
     the range filled by the mirrored body half a period earlier. Returns (cycle start, cycle
     length). The root's location repeats in place, or advances by one cycle's travel each
@@ -154,9 +159,15 @@ def make_cycle(arm, first: int, last: int, period: float | None = None,
         try:
             period = gait_period(values[:, rotations])
         except CycleError:
+            period = 0.0
+        if period < MIN_GAIT_SECONDS * fps:
             raise BridgeError(f"frames {first}-{last} hold too little of a walk to find its "
                               f"period: set the Period (frames per cycle)") from None
     n = int(round(period))
+    if n < blend + 3:
+        raise BridgeError(f"a cycle of {n} frames is too short to loop with a Blend of "
+                          f"{blend} frames: set a longer Period, or a Blend of at most "
+                          f"{max(n - 3, 1)}")
     if mirror:
         if 2 * len(frames) < period:
             raise BridgeError(f"frames {first}-{last} are less than half of a {n}-frame cycle: "
@@ -237,7 +248,8 @@ class TWIST_OT_make_cycle(ArmatureAction, bpy.types.Operator):
         period = (scene.frame_end - scene.frame_start + 1 if self.range_is_cycle
                   else self.period or None)
         start, n = make_cycle(scene.twist.armature, scene.frame_start, scene.frame_end,
-                              period, self.blend, self.in_place, self.mirror)
+                              period, self.blend, self.in_place, self.mirror,
+                              scene.render.fps / scene.render.fps_base)
         return f"a cycle of {n} frames from frame {start}, repeating"
 
 

@@ -49,6 +49,22 @@ def test_make_cycle_needs_tracked_motion(bpy_module, registered):
         bpy.ops.twist.make_cycle()
 
 
+def test_a_range_too_short_for_a_walk_or_its_blend_is_refused_with_what_to_set(bpy_module,
+                                                                              registered):
+    """Five frames of the walk hold no gait (a period found there would be under half a
+    second); a given period shorter than the blend allows is refused too, saying what fits."""
+    bpy = bpy_module
+    scene, arm = walking_template(bpy, registered)
+    scene.frame_start, scene.frame_end = 1, 5
+    with pytest.raises(RuntimeError, match="frames 1-5 hold too little of a walk to find its "
+                                           "period: set the Period"):
+        bpy.ops.twist.make_cycle()
+    with pytest.raises(RuntimeError, match="a cycle of 5 frames is too short to loop with a "
+                                           "Blend of 4 frames: set a longer Period, or a Blend"
+                                           " of at most 2"):
+        bpy.ops.twist.make_cycle(period=5)
+
+
 def _bone_rotations(arm, bag, frames):
     """Each tracked bone's rotation per frame as a quaternion (w, x, y, z), from its curves."""
     from mathutils import Euler, Quaternion
