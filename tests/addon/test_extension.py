@@ -117,3 +117,16 @@ def test_track_runs_through_the_installed_extension(installed, tmp_path):
     assert out["keys"] == [[2, "GENERATED"], [3, "GENERATED"]]
     assert out["tracked"] == 2
 
+
+
+def test_the_manifest_asks_for_the_blender_the_add_on_is_tested_with():
+    """The add-on uses Blender 5's animation API (action slots and channelbags) and is tested
+    with the bpy module only: its manifest must not promise an older Blender."""
+    import tomllib
+
+    import bpy
+
+    manifest = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
+    wanted = tuple(int(x) for x in manifest["blender_version_min"].split("."))
+    assert wanted <= tuple(bpy.app.version)
+    assert wanted[:2] == tuple(bpy.app.version)[:2]
