@@ -33,6 +33,43 @@ def load_grey(path: str | Path) -> np.ndarray:
     return to_grey(img)
 
 
+def check_readable(paths, where: str) -> None:
+    """ImageError naming the first of the image files ``paths`` (str or Path; other sources,
+    a movie's frames or arrays, are not checked) that cannot be decoded, before any is
+    tracked: a file cut short in the middle of a sequence must not stop a run half way. The
+    decoder's own complaints are kept off the terminal; the error says what to do."""
+    files = [p for p in paths if isinstance(p, (str, Path))]
+    if not files:
+        return
+    with _quiet_stderr():
+        bad = next((p for p in files if cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) is None),
+                   None)
+    if bad is not None:
+        raise ImageError(f"{bad}: cannot read this image ({where}; cut short, or not an "
+                         "image format): replace it, or leave it out of the footage")
+
+
+class _quiet_stderr:
+    """Standard error at the file-descriptor level sent nowhere (libpng and libjpeg write to
+    it directly)."""
+
+    def __enter__(self):
+        import os
+        import sys
+
+        sys.stderr.flush()
+        self._saved = os.dup(2)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 2)
+        os.close(devnull)
+
+    def __exit__(self, *exc):
+        import os
+
+        os.dup2(self._saved, 2)
+        os.close(self._saved)
+
+
 def to_grey(img: np.ndarray) -> np.ndarray:
     """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 grey in [0, 1]."""
     if img.dtype == np.uint8:

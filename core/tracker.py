@@ -51,6 +51,7 @@ from .solver import (
 SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
 BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
 ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
+MIN_LEVEL_PIXELS = 16  # the coarsest pyramid level keeps images at least this large
 
 
 def _knob(default, doc: str):
@@ -300,8 +301,10 @@ class Tracker:
                 self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})),
                 sil.BODY_MARGIN * self._scales.magnification(c))
             if not backdrop.still:
-                self.notes.append(f"view {c + 1}: the backdrop changes from frame to "
-                                  "frame (a moving camera?), so its silhouette is not used")
+                self.notes.append(f"view {c + 1}: the footage around the body changes from "
+                                  "frame to frame far more than a body's outline (a moving "
+                                  "camera or light, or a first pose that does not cover the "
+                                  "body), so its silhouette is not used")
             self._backdrops.append(backdrop if backdrop.still else None)
 
     def _foreground(self, view: int, frame: int) -> np.ndarray:
@@ -313,20 +316,18 @@ class Tracker:
         return self._fg_cache[view, frame]
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
-                      ) -> BodyPose:
+                      ) -> tuple[BodyPose, list[str]]:
         """``est`` with every limb turned to where the silhouette wants it (``LimbSearch``),
-        on the level below full resolution; ``est`` itself when nothing turned."""
+        on the level below full resolution, and the joints that turned."""
         if self.settings.silhouette <= 0:
-            return est
+            return est, []
         self._learn_first_backdrops(key, key_frame)
         lvs = self._scales.view_levels(self._scales.search_level())
         fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
                for c, (b, lv) in enumerate(zip(self._backdrops, lvs))]
         if all(f is None for f in fgs):
-            return est
-        searched, turned = self._search.run(
-            est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
-        return searched if turned else est
+            return est, []
+        return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
 
     def _scale_to(self, pose: BodyPose) -> None:
         """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
@@ -595,8 +596,8 @@ class Tracker:
                 sets.append(_PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and level == self._scales.search_level():
-                searched = self._search_limbs(est, frame, key, key_frame)
-                if searched is not est:  # the prediction from here on (what prior holds to)
+                searched, turned = self._search_limbs(est, frame, key, key_frame)
+                if turned:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)
             active = self._active(est, level)
@@ -649,6 +650,32 @@ class Tracker:
         return result
 
     # --- the sequence ----------------------------------------------------------------------
+    def _check_start(self, initial: BodyPose, frame: int) -> None:
+        """InputError unless every view's image files can be read, its images are large
+        enough for the pyramid asked for, and the first pose puts the body inside every
+        view's image (a camera looking away, or a pose far off, would otherwise read as a
+        divergence on the next frame)."""
+        for c in range(self.seq.n_views):
+            imagelib.check_readable(self.seq.images[c], f"view {c + 1}'s footage")
+        kin = Kinematics(self.skeleton, initial)
+        centres = kin.world_points(self._blobs.joint, self._blobs.centre)
+        for c, view in enumerate(initial.views):
+            h, w = self.seq.grey(c, frame).shape
+            most = int(np.log2(min(h, w) / MIN_LEVEL_PIXELS)) + 1
+            if self.settings.levels > most:
+                raise InputError(
+                    f"settings.levels: {self.settings.levels} pyramid levels shrink view "
+                    f"{c + 1}'s {w}x{h} images below {MIN_LEVEL_PIXELS} pixels; use at most "
+                    f"{max(most, 1)}")
+            px = view.project(centres)
+            inside = np.mean((px[:, 0] >= 0) & (px[:, 0] < w) & (px[:, 1] >= 0)
+                             & (px[:, 1] < h))
+            if inside < self.settings.min_inside:
+                raise InputError(
+                    f"on the first frame only {inside:.0%} of the body is inside view {c + 1}'s "
+                    "image: check where that view's camera looks and that the pose lines up "
+                    "with the footage")
+
     def _predicted(self, before: BodyPose, last: BodyPose) -> BodyPose:
         """Constant-velocity prediction from the poses of the two frames before, except that a
         limited hinge whose turn would carry it past its limits is predicted where it was:
@@ -681,6 +708,7 @@ class Tracker:
             raise InputError(
                 f"the pose has {len(initial.views)} views, the footage {self.seq.n_views}"
             )
+        self._check_start(initial, frames[0])
         key_frame, key = frames[0], initial
         self._key_sets.clear()  # the key pose may differ from an earlier run's
         self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it

@@ -108,19 +108,54 @@ def test_an_output_folder_that_does_not_exist_stops_the_run_before_it_starts(foo
     assert "frame" not in proc.stderr and not any(tmp_path.iterdir())  # nothing tracked
 
 
-def test_a_diverged_runs_report_is_strict_json(footage, tmp_path):
-    """Every frame flagged (the body must stay more than wholly inside the images): the run
-    stops at frame 1, writes frame 0, and its report has null where a residual is none."""
+def test_a_diverged_runs_report_is_strict_json_and_its_bvh_ends_before_it(footage,
+                                                                          tmp_path):
+    from core.run import report, result_bvh, write_report
+    from core.tracker import FrameResult, TrackResult
+
+    folder, _ = footage
+    job = load_job(folder / "job.json")
+    result = TrackResult([
+        FrameResult(frame=0, pose=job.initial, residual=0.0, iterations=0, converged=True,
+                    given=True),
+        FrameResult(frame=1, pose=job.initial, residual=float("nan"), iterations=0,
+                    converged=False, diverged=True, reason="the body left the image")])
+    write_report(tmp_path / "report.json", report(job, result, 1.0))
+    rep = json.loads((tmp_path / "report.json").read_text(),
+                     parse_constant=lambda c: pytest.fail(f"{c} is not JSON"))
+    assert rep["frames"][1]["residual"] is None and rep["diverged_frames"] == [1]
+    assert (rep["frames_tracked"], rep["frames_total"]) == (0, 2)
+    assert len(result_bvh(job, result).motion) == 1
+
+
+def test_an_image_that_cannot_be_read_is_named_before_any_frame_is_tracked(footage, tmp_path):
     folder, job = footage
-    job_path = folder / "job_diverges.json"
+    broken = folder / "broken"
+    broken.mkdir(exist_ok=True)
+    for f in range(3):
+        data = (folder / "side" / f"{f:03d}.png").read_bytes()
+        (broken / f"{f:03d}.png").write_bytes(data if f < 2 else data[:200])  # cut short
+    job_path = folder / "job_broken.json"
+    views = [dict(job["views"][0], images="broken/*.png")] + job["views"][1:]
+    job_path.write_text(json.dumps(dict(job, views=views)))
+    out = tmp_path / "out.bvh"
+    proc = _run("track", job_path, "--out", out, "--report", tmp_path / "r.json")
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith("error: ")  # the decoder's own words are not shown
+    assert "002.png: cannot read this image (view 1's footage; cut short" in proc.stderr
+    assert "frame" not in proc.stderr.split("error")[0] and not out.exists()
+
+
+def test_a_first_pose_outside_a_view_is_refused_before_tracking(footage, tmp_path):
+    """The body must stand more than wholly inside the images (min_inside 1.5): no first
+    pose can, and the run says so instead of reporting a divergence on the next frame."""
+    folder, job = footage
+    job_path = folder / "job_outside.json"
     job_path.write_text(json.dumps(dict(job, settings={"min_inside": 1.5})))
-    out, rep = tmp_path / "out.bvh", tmp_path / "report.json"
-    proc = _run("track", job_path, "--out", out, "--report", rep)
-    assert proc.returncode == 3, proc.stderr
-    assert "tracked 0 of 2 frames after the first" in proc.stderr
-    report = json.loads(rep.read_text(), parse_constant=lambda c: pytest.fail(c))
-    assert report["frames"][1]["residual"] is None and report["diverged_frames"] == [1]
-    assert len(read_bvh(out).motion) == 1
+    proc = _run("track", job_path, "--out", tmp_path / "out.bvh")
+    assert proc.returncode == 2, proc.stderr
+    assert "on the first frame only 100% of the body is inside view 1's image" in proc.stderr
+    assert not (tmp_path / "out.bvh").exists()
 
 
 def test_the_command_line_says_what_it_does_and_runs_from_any_folder(tmp_path):

@@ -135,6 +135,8 @@ def test_the_tracker_leaves_out_and_notes_a_view_whose_backdrop_moves():
     cover = render(sk, pose, 0, background=0.0) == render(sk, pose, 0, background=1.0)
     frames = [[np.where(cover, body, wall[:, 8 * k: 8 * k + 320]) for k in range(6)]]
     res = track(Tracker(sk, frames, INDEPENDENT), pose, range(6))
-    assert res.notes == ["view 1: the backdrop changes from frame to frame (a moving "
-                         "camera?), so its silhouette is not used"]
+    assert res.notes == ["view 1: the footage around the body changes from frame to frame "
+                         "far more than a body's outline (a moving camera or light, or a "
+                         "first pose that does not cover the body), so its silhouette is "
+                         "not used"]
     assert len(res.frames) == 6 and not res.diverged_frames

@@ -239,11 +239,16 @@ def test_a_body_that_leaves_the_images_is_reported_not_tracked(body):
     frames = [[render(sk, pose, c), np.full((360, 320), 0.3, np.float32)] for c in range(3)]
     shifted = pose.copy()
     for v in shifted.views:
-        v.center = v.center + np.array([400.0, 0.0])  # the body starts off to the side
-    res = track(Tracker(sk, frames, INDEPENDENT), shifted, [0, 1])
-    assert res.frames[-1].diverged
-    assert res.frames[-1].reason == "the body left the image of view 1, 2, 3"
-    assert res.diverged_frames == [1]
+        v.center = v.center + np.array([400.0, 0.0])  # predicted off to the side
+    res = Tracker(sk, frames, INDEPENDENT).track_frame(pose, 0, pose, 0, shifted, 1)
+    assert res.diverged and res.reason == "the body left the image of view 1, 2, 3"
+    # a first pose off the images is the user's to fix, not a divergence
+    with pytest.raises(InputError, match="on the first frame only 0% of the body is inside "
+                                         "view 1's image: check where"):
+        track(Tracker(sk, frames, INDEPENDENT), shifted, [0, 1])
+    with pytest.raises(InputError, match="settings.levels: 6 pyramid levels shrink view 1's "
+                                         "320x360 images below 16 pixels; use at most 5"):
+        track(Tracker(sk, frames, INDEPENDENT, TrackerSettings(levels=6)), pose, [0, 1])
 
 
 def test_bad_input_is_refused_with_a_reason(body):
