@@ -16,14 +16,16 @@ import argparse
 import dataclasses
 import os
 import sys
+import time
 from pathlib import Path
 
 from .bvh import write_bvh
-from .image import ImageError
+from .errors import InputError
 from .init_fit import FitError, fit_pose, least_certain
 from .job import JobError, load_fit, load_job
 from .pose import world_pose
 from .run import report, result_bvh, timed_run, write_report
+from .tracker import TrackResult
 
 
 def _writable(path: str, what: str) -> str:
@@ -48,16 +50,26 @@ def _track(args) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
 
+    done_so_far = TrackResult()
+
     def progress(res, done, total):
+        done_so_far.frames.append(res)
         if not args.quiet:
             flag = f"  DIVERGED: {res.reason}" if res.diverged else ""
             print(f"frame {res.frame:4d}  {done}/{total}  residual {res.residual:.4f}"
                   f"  iterations {res.iterations}{flag}", file=sys.stderr)
 
+    t0 = time.perf_counter()
     try:
         result, seconds = timed_run(job, progress)
-    except ImageError as e:
+    except InputError as e:  # a frame that cannot be read, a pose outside a view...
         print(f"error: {e}", file=sys.stderr)
+        if len(done_so_far.frames) > 1:  # what was tracked is kept
+            write_bvh(result_bvh(job, done_so_far), args.out)
+            if args.report:
+                write_report(args.report, report(job, done_so_far, time.perf_counter() - t0))
+            print(f"the {len(done_so_far.frames)} frames before it are written to {args.out}",
+                  file=sys.stderr)
         return 2
     write_bvh(result_bvh(job, result), args.out)
     if args.report:
