@@ -181,6 +181,7 @@ def main(argv=None) -> int:
                     help="the folder holding the Bandai Namco clips (bn_*.bvh), to add them")
     ap.add_argument("--clips", help="comma-separated clip names (default: all)")
     ap.add_argument("--looks", default=",".join(LOOKS), help="comma-separated look names")
+    ap.add_argument("--runs", help="comma-separated run names (default: all, or --quick's)")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     ap.add_argument("--write", type=Path, help="also write the tables to this markdown file")
     a = ap.parse_args(argv)
@@ -195,7 +196,7 @@ def main(argv=None) -> int:
     if a.clips:
         clips = [c for c in clips if c.name in a.clips.split(",")]
     looks = a.looks.split(",")
-    runs = list(QUICK_RUNS if a.quick else RUNS)
+    runs = a.runs.split(",") if a.runs else list(QUICK_RUNS if a.quick else RUNS)
     settings = json.loads(a.settings)
     t0 = time.perf_counter()
     jobs = []

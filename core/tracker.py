@@ -52,6 +52,7 @@ SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equat
 BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
 ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
 MIN_LEVEL_PIXELS = 16  # the coarsest pyramid level keeps images at least this large
+MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its points are visible there
 
 
 def _knob(default, doc: str):
@@ -100,11 +101,13 @@ class TrackerSettings:
                               "than brightness reaches. Needs cameras that stand still")
     silhouette_cap: float = _knob(24.0, "Farthest a silhouette mismatch pulls, in pixels of "
                                   "the full image")
-    side_on: bool = _knob(False, "With one view (or views along one line): track every "
-                          "joint that could turn toward or away from the camera as a hinge "
-                          "about the line of sight at the first frame, as the paper does "
-                          "with one camera: the limbs follow the footage in the image, and "
-                          "nothing moves in depth")
+    side_on: bool = _knob(True, "Where every view looks along one line (one view): track "
+                          "every joint that could turn toward or away from the camera as a "
+                          "hinge about the line of sight at the first frame, as the paper "
+                          "does with one camera: the limbs follow the footage in the image, "
+                          "and what the footage does not show in depth is held, not guessed "
+                          "(off: those turns are read from foreshortening alone). Views that "
+                          "look different ways are not affected")
     limb_search: float = _knob(0.1, "Before refining a frame, turn each limb over a grid of "
                                "angles against the silhouette and keep the best turn when it "
                                "beats the prediction by this share of the limb's outline, "
@@ -328,6 +331,43 @@ class Tracker:
         if all(f is None for f in fgs):
             return est, []
         return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
+
+    def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
+                   sets: list[_PointSet], levels: list, level: int) -> BodyPose:
+        """``est`` with the turns of ``searched`` that the pixels bear out: a limb's turn is
+        kept only when, in every view that sees the limb, its pixels of the earlier frames
+        match the new image clearly better turned than not (the mean of their costs'
+        differences over twice its standard error); else the limb keeps its predicted
+        motion. The silhouette proposes, brightness decides: an outline alone also fits
+        shadows, clutter and the gaps between other limbs. A limb no view's earlier pixels
+        show (it was hidden) has only its outline to go by, and the search's own test
+        stands."""
+        kin = Kinematics(self.skeleton, est)
+        base = self._sample(est, kin, sets, levels, level)
+        moved = self.skeleton.moved_by()
+        bounds = np.cumsum([0] + [len(ps.value) for ps in sets])
+        out = est
+        for limb in self._search.limbs:
+            if self.skeleton.names[limb.joint] not in turned:
+                continue
+            cand = out.copy()
+            for j, _, _ in limb.dofs:
+                cand.rotations[j] = searched.rotations[j]
+            trial = self._sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
+                                 base.sigmas)
+            seen = clear = 0
+            for c, ps in enumerate(sets):
+                on = moved[ps.seg_joint, limb.joint]
+                old, new = (x[bounds[c]:bounds[c + 1]][on] for x in (base.costs, trial.costs))
+                both = ~np.isnan(old) & ~np.isnan(new)
+                if both.sum() < MIN_LIMB_POINTS:
+                    continue  # this view does not see the limb (hidden, or too small)
+                seen += 1
+                d = old[both] - new[both]
+                clear += d.mean() > 2 * d.std() / np.sqrt(len(d))
+            if clear == seen:  # no view's pixels see it (hidden before): the outline decides
+                out = cand
+        return out
 
     def _scale_to(self, pose: BodyPose) -> None:
         """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
@@ -597,7 +637,9 @@ class Tracker:
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and level == self._scales.search_level():
                 searched, turned = self._search_limbs(est, frame, key, key_frame)
-                if turned:  # the prediction from here on (what prior holds to)
+                if turned:
+                    searched = self._evidenced(est, searched, turned, sets, levels, level)
+                if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)
             active = self._active(est, level)
