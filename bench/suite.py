@@ -222,7 +222,18 @@ def main(argv=None) -> int:
                  f" {len(looks)} looks x {len(runs)} runs")
     print("\n".join(lines))
     if a.write:
-        a.write.write_text("\n".join(lines) + "\n")
+        head = [
+            "# Benchmark results", "",
+            f"Written by `make bench` (`bench/suite.py`) on {time.strftime('%Y-%m-%d')}"
+            f"{' with the settings ' + a.settings if settings else ''}. Each clip is two "
+            "seconds of real motion capture rendered in each look and tracked with the "
+            "default settings and the default blobs. *tracker*, *held still* (the first "
+            "frame's pose kept) and *best fit* (the tracked degrees of freedom fitted to the "
+            "true joints, the floor) are limb-direction errors over the eight limbs; *image "
+            "err* (one view) is how far the tracked limb ends stray from the true ones in the "
+            "image, in % of the body's height. A run that stops keeps its last pose. See "
+            "`bench/suite.py` and `bench/suite_footage.py` for the clips and looks.", ""]
+        a.write.write_text("\n".join(head + lines) + "\n")
     return 0
 
 
