@@ -33,20 +33,30 @@ def load_grey(path: str | Path) -> np.ndarray:
     return to_grey(img)
 
 
-def check_readable(paths, where: str) -> None:
+def check_footage(paths, where: str) -> None:
     """ImageError naming the first of the image files ``paths`` (str or Path; other sources,
-    a movie's frames or arrays, are not checked) that cannot be decoded, before any is
-    tracked: a file cut short in the middle of a sequence must not stop a run half way. The
-    decoder's own complaints are kept off the terminal; the error says what to do."""
+    a movie's frames or arrays, are not checked) that cannot be decoded, or that differs in
+    size from the first, before any is tracked: a file cut short in the middle of a sequence
+    must not stop a run half way, and frames of one view are one camera's (cells cropped
+    each its own way are not). The decoder's own complaints are kept off the terminal."""
     files = [p for p in paths if isinstance(p, (str, Path))]
-    if not files:
-        return
+    size = None
     with _quiet_stderr():
-        bad = next((p for p in files if cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) is None),
-                   None)
-    if bad is not None:
-        raise ImageError(f"{bad}: cannot read this image ({where}; cut short, or not an "
-                         "image format): replace it, or leave it out of the footage")
+        for p in files:
+            img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                break
+            if size is None:
+                size, first = img.shape, p
+            elif img.shape != size:
+                raise ImageError(
+                    f"{where}: its images differ in size ({Path(first).name} is "
+                    f"{size[1]}x{size[0]}, {Path(p).name} {img.shape[1]}x{img.shape[0]}): "
+                    "crop or pad them to one size, lined up as the camera saw them")
+        else:
+            return
+    raise ImageError(f"{p}: cannot read this image ({where}; cut short, or not an image "
+                     "format): replace it, or leave it out of the footage")
 
 
 class _quiet_stderr:

@@ -109,6 +109,15 @@ def _images(spec, base: Path, where: str):
     raise JobError(f"{where}: expected a movie file, a glob pattern or a list of image paths")
 
 
+def _reaches_out(sk: Skeleton, j: int) -> bool:
+    """Whether anything joint j turns (a joint or end site below it) lies away from it."""
+    rest = sk.rest_positions
+    below = np.flatnonzero(sk.moved_by()[:, j])
+    tips = [rest[k] + e for k in below for e in sk.end_sites[k]]
+    points = np.concatenate([rest[below], np.reshape(tips, (-1, 3))])
+    return bool(np.any(np.linalg.norm(points - rest[j], axis=1) > 1e-9))
+
+
 def _apply_joints(sk: Skeleton, spec, where: str) -> None:
     if not isinstance(spec, dict) or not spec:
         raise JobError(f"{where}: expected an object naming the tracked joints")
@@ -124,6 +133,10 @@ def _apply_joints(sk: Skeleton, spec, where: str) -> None:
         if j == 0 and kind != FIXED:
             raise JobError(f"{where}.{name}: the root moves with the view poses; track its"
                            " children instead")
+        if kind != FIXED and not _reaches_out(sk, j):
+            raise JobError(f"{where}.{name}: every bone below this joint has zero length in "
+                           "the BVH, so no pixel can show it turn: track another joint, or "
+                           "give the BVH's offsets their lengths")
         sk.kinds[j] = kind
         if kind == HINGE:
             if not isinstance(js, dict) or "axis" not in js:

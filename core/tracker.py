@@ -693,12 +693,12 @@ class Tracker:
 
     # --- the sequence ----------------------------------------------------------------------
     def _check_start(self, initial: BodyPose, frame: int) -> None:
-        """InputError unless every view's image files can be read, its images are large
-        enough for the pyramid asked for, and the first pose puts the body inside every
+        """InputError unless every view's image files can be read and share one size, that
+        size fits the pyramid asked for, and the first pose puts the body inside every
         view's image (a camera looking away, or a pose far off, would otherwise read as a
         divergence on the next frame)."""
         for c in range(self.seq.n_views):
-            imagelib.check_readable(self.seq.images[c], f"view {c + 1}'s footage")
+            imagelib.check_footage(self.seq.images[c], f"view {c + 1}'s footage")
         kin = Kinematics(self.skeleton, initial)
         centres = kin.world_points(self._blobs.joint, self._blobs.centre)
         for c, view in enumerate(initial.views):

@@ -146,6 +146,22 @@ def test_an_image_that_cannot_be_read_is_named_before_any_frame_is_tracked(foota
     assert "frame" not in proc.stderr.split("error")[0] and not out.exists()
 
 
+def test_images_of_one_view_in_two_sizes_are_refused_before_tracking(footage, tmp_path):
+    folder, job = footage
+    mixed = folder / "mixed"
+    mixed.mkdir(exist_ok=True)
+    for f in range(3):
+        img = cv2.imread(str(folder / "side" / f"{f:03d}.png"))
+        cv2.imwrite(str(mixed / f"{f:03d}.png"), img if f != 1 else img[:-3])
+    job_path = folder / "job_mixed.json"
+    job_path.write_text(json.dumps(dict(job, views=[dict(job["views"][0], images="mixed/*.png")]
+                                        + job["views"][1:])))
+    proc = _run("track", job_path, "--out", tmp_path / "out.bvh")
+    assert proc.returncode == 2, proc.stderr
+    assert ("view 1's footage: its images differ in size (000.png is 320x300, 001.png 320x297)"
+            ": crop or pad them to one size") in proc.stderr
+
+
 def test_a_first_pose_outside_a_view_is_refused_before_tracking(footage, tmp_path):
     """The body must stand more than wholly inside the images (min_inside 1.5): no first
     pose can, and the run says so instead of reporting a divergence on the next frame."""
@@ -234,6 +250,23 @@ def test_malformed_jobs_get_one_clear_error(footage, tmp_path, change, message):
         broken.write_text(good)
     assert proc.returncode == 2 and proc.stderr.startswith("error: job.json")
     assert not (tmp_path / "x.bvh").exists()
+
+
+def test_a_tracked_joint_with_nothing_away_from_it_is_refused(footage, tmp_path):
+    """The left toe's end site moved onto the toe joint: its bone has no length, so no pixel
+    can show the toe turn; tracking it is an error naming the joint."""
+    folder, job = footage
+    bvh = read_bvh(folder / "walk.bvh")
+    toe = bvh.names.index("LeftToe")
+    bvh.joints[toe].end_sites = [np.zeros(3)]
+    write_bvh(bvh, tmp_path / "flat_toe.bvh")
+    spec = json.loads(json.dumps(job))
+    spec["skeleton"] = {"bvh": str(tmp_path / "flat_toe.bvh"),
+                        "joints": dict(job["skeleton"]["joints"], LeftToe="ball")}
+    (tmp_path / "job.json").write_text(json.dumps(spec))
+    with pytest.raises(JobError, match="joints.LeftToe: every bone below this joint has zero "
+                                       "length in the BVH, so no pixel can show it turn"):
+        load_job(tmp_path / "job.json")
 
 
 def test_camera_parsing_maps_world_points_as_documented():
