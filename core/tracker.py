@@ -185,7 +185,7 @@ class TrackResult:
 
 
 @dataclass
-class _PointSet:
+class PointSet:
     """Body pixels of earlier frames in one view, ready to be mapped to the new frame: one
     frame's, or several frames' one after the other (``lengths``: how many each; each has
     its own noise scale)."""
@@ -199,11 +199,11 @@ class _PointSet:
     lengths: tuple[int, ...] = ()  # points per frame, when several frames are joined
 
     @staticmethod
-    def joined(sets: list[_PointSet]) -> _PointSet:
+    def joined(sets: list[PointSet]) -> PointSet:
         """One set of the points of ``sets`` (all of one view), in order."""
         if len(sets) == 1:
             return sets[0]
-        return _PointSet(sets[0].view, *(np.concatenate([getattr(ps, f) for ps in sets])
+        return PointSet(sets[0].view, *(np.concatenate([getattr(ps, f) for ps in sets])
                                          for f in ("seg_joint", "blob", "ref", "value",
                                                    "weight")),
                          tuple(len(ps.value) for ps in sets))
@@ -239,8 +239,10 @@ class Tracker:
         self.mode = mode
         self.settings = settings or TrackerSettings()
         self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
-        self._scales = Scales.unscaled(self.seq.n_views, self.settings)  # as seq is built
-        self._key_sets: dict[tuple[int, int, int], _PointSet] = {}  # (frame, view, level)
+        # each view's pixel sizes for the body's size there (``scale_to``), as seq is built
+        self.scales = Scales.unscaled(self.seq.n_views, self.settings)
+        # the key frame's points by (frame, view, level), kept while the key frame is
+        self.key_sets: dict[tuple[int, int, int], PointSet] = {}
         self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
         self.notes: list[str] = []  # what the user should know about the run
         self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
@@ -275,9 +277,9 @@ class Tracker:
             if self._backdrops[c] is None:
                 out.append(None)
                 continue
-            lv = self._scales.view_level(c, level)
-            g = self._scales.grid(c, lv)
-            margin = self._scales.cap(c) / 2**lv + 2 * g
+            lv = self.scales.view_level(c, level)
+            g = self.scales.grid(c, lv)
+            margin = self.scales.cap(c) / 2**lv + 2 * g
             shape = self.seq.pyramid(c, frame)[lv].shape
             boxes = raycast.blob_boxes(est.views[c].at_level(lv), self._blobs,
                                        kin.segments)
@@ -302,7 +304,7 @@ class Tracker:
             grey = self.seq.grey(c, key_frame)
             backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), (
                 self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})),
-                sil.BODY_MARGIN * self._scales.magnification(c))
+                sil.BODY_MARGIN * self.scales.magnification(c))
             if not backdrop.still:
                 self.notes.append(f"view {c + 1}: the footage around the body changes from "
                                   "frame to frame far more than a body's outline (a moving "
@@ -325,7 +327,7 @@ class Tracker:
         if self.settings.silhouette <= 0:
             return est, []
         self._learn_first_backdrops(key, key_frame)
-        lvs = self._scales.view_levels(self._scales.search_level())
+        lvs = self.scales.view_levels(self.scales.search_level())
         fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
                for c, (b, lv) in enumerate(zip(self._backdrops, lvs))]
         if all(f is None for f in fgs):
@@ -333,7 +335,7 @@ class Tracker:
         return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
 
     def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
-                   sets: list[_PointSet], levels: list, level: int) -> BodyPose:
+                   sets: list[PointSet], levels: list, level: int) -> BodyPose:
         """``est`` with the turns of ``searched`` that the pixels bear out: a limb's turn is
         kept only when, in every view that sees the limb, its pixels of the earlier frames
         match the new image clearly better turned than not (the mean of their costs'
@@ -343,7 +345,7 @@ class Tracker:
         show (it was hidden) has only its outline to go by, and the search's own test
         stands."""
         kin = Kinematics(self.skeleton, est)
-        base = self._sample(est, kin, sets, levels, level)
+        base = self.sample(est, kin, sets, levels, level)
         moved = self.skeleton.moved_by()
         bounds = np.cumsum([0] + [len(ps.value) for ps in sets])
         out = est
@@ -353,7 +355,7 @@ class Tracker:
             cand = out.copy()
             for j, _, _ in limb.dofs:
                 cand.rotations[j] = searched.rotations[j]
-            trial = self._sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
+            trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
                                  base.sigmas)
             seen = clear = 0
             for c, ps in enumerate(sets):
@@ -369,21 +371,21 @@ class Tracker:
                 out = cand
         return out
 
-    def _scale_to(self, pose: BodyPose) -> None:
+    def scale_to(self, pose: BodyPose) -> None:
         """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
         what was built for another size is dropped."""
         scales = Scales.of(self.skeleton, pose, self.settings)
-        if scales != self._scales:
-            self._scales = scales
+        if scales != self.scales:
+            self.scales = scales
             self.seq.set_levels(scales.pyramid_levels())
-            self._key_sets.clear()
+            self.key_sets.clear()
             self._backdrops, self._fg_cache = None, {}
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
         (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
         an error the backdrop's margin (as many times wider) covers."""
-        g = self._scales.magnification(view)
+        g = self.scales.magnification(view)
         covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 
@@ -408,10 +410,10 @@ class Tracker:
                                self.dof_thickness * scale >= self.settings.min_blob_pixels])
 
     # --- point sets ---------------------------------------------------------------------
-    def _point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
-                   set_weight: float) -> _PointSet:
+    def point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
+                   set_weight: float) -> PointSet:
         level = self.seq.pyramid(view, frame)[lv]
-        step = self._scales.grid(view, lv)
+        step = self.scales.grid(view, lv)
         v_l = pose.views[view].at_level(lv)
         pix_l, hits, _ = raycast.render_labels(
             v_l, self._blobs, kin.segments, level.shape, step
@@ -424,7 +426,7 @@ class Tracker:
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
         value = level.stack[pix_l[:, 1], pix_l[:, 0], 0].astype(float)
         rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
-        return _PointSet(view, seg_joint, label, ref, value, rim * set_weight)
+        return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
 
     def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int,
                    grid: int):
@@ -443,7 +445,7 @@ class Tracker:
         return lab, idx, hits
 
     # --- one level -----------------------------------------------------------------------
-    def _sample(self, est: BodyPose, kin: Kinematics, sets: list[_PointSet], levels: list,
+    def sample(self, est: BodyPose, kin: Kinematics, sets: list[PointSet], levels: list,
                 level: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
                 ) -> _Samples:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
@@ -454,8 +456,8 @@ class Tracker:
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
-        lvs = self._scales.view_levels(level)
-        gs = [self._scales.grid(c, lv) for c, lv in enumerate(lvs)]
+        lvs = self.scales.view_levels(level)
+        gs = [self.scales.grid(c, lv) for c, lv in enumerate(lvs)]
         maps = [self._label_map(est, kin, c, levels[c].shape, lvs[c], gs[c])
                 for c in range(self.seq.n_views)]
         labels = [m[0] for m in maps]
@@ -468,7 +470,7 @@ class Tracker:
                 fg, (x0, y0), nearest_fg = view_fg
                 crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
                 full = 2**lvs[c] * gs[c]  # full-resolution pixels per map pixel
-                mm = sil.mismatch(lab[crop], fg, self._scales.cap(c) / full,
+                mm = sil.mismatch(lab[crop], fg, self.scales.cap(c) / full,
                                   nearest_fg=nearest_fg)
                 shape_cost += s.silhouette * mm.cost
                 mm.model += (x0, y0)
@@ -502,13 +504,13 @@ class Tracker:
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         measured if sigmas is None else sigmas, shape_cost, shape_parts)
 
-    def _pixel_weights(self, ps: _PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
+    def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
                        ) -> np.ndarray:
         """Weights of a point set's usable points ``ok`` with residuals ``r`` (the set's
         points' noise scales ``sigma``): their rim weight times the EM support posterior."""
         return ps.weight[ok] * support_weights(r, sigma[ok], self.settings.outlier_density)
 
-    def _normal_equations(self, kin: Kinematics, sets: list[_PointSet], smp: _Samples,
+    def _normal_equations(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
                           sigmas: list[np.ndarray], level: int) -> NormalEquations:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
         and the silhouette's rows (each mismatched pixel's two coordinates); one block of
@@ -522,8 +524,8 @@ class Tracker:
         for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
             if not len(joints):
                 continue
-            lv = self._scales.view_level(c, level)
-            g = 2**lv * self._scales.grid(c, lv)  # full-resolution pixels per map pixel
+            lv = self.scales.view_level(c, level)
+            g = 2**lv * self.scales.grid(c, lv)  # full-resolution pixels per map pixel
             every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
             joints, world, target = joints[::every], world[::every], target[::every]
             pair_w = pair_w[::every]
@@ -542,7 +544,7 @@ class Tracker:
                 ne.add(rows(kin, c, self.mode, joints, q, grad), r, w)
         return ne
 
-    def _sigmas(self, ps: _PointSet, r: np.ndarray, inside: np.ndarray) -> np.ndarray:
+    def _sigmas(self, ps: PointSet, r: np.ndarray, inside: np.ndarray) -> np.ndarray:
         """Residual scale of a point set's points (N,) from their residuals ``r`` (N,) and
         which fell inside the image: one scale per frame the set joins."""
         lengths = ps.lengths or (len(r),)
@@ -551,7 +553,7 @@ class Tracker:
                   for part_r, part_in in zip(np.split(r, cuts), np.split(inside, cuts))]
         return np.repeat(scales, lengths)
 
-    def _residual(self, sets: list[_PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
+    def _residual(self, sets: list[PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
         """RMS brightness error of the pixels that follow the body (support-weighted), in
         image units: what the report calls a frame's residual."""
         num = den = 0.0
@@ -597,12 +599,12 @@ class Tracker:
         (view, segment joints (N,), scaled camera points q (N, 3), image gradients (N, 2),
         brightness residuals (N,), EM support weights (N,)). For estimates made outside the
         tracker's own system (the skeleton's refinement)."""
-        self._scale_to(prev)
+        self.scale_to(prev)
         kin_prev, kin = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, est)
         levels = [self.seq.pyramid(c, frame)[0] for c in range(self.seq.n_views)]
-        sets = [self._point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
+        sets = [self.point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
                 for c in range(self.seq.n_views)]
-        smp = self._sample(est, kin, sets, levels, 0)
+        smp = self.sample(est, kin, sets, levels, 0)
         out = []
         for ps, sigma, (ok, q, grad, r) in zip(sets, smp.sigmas, smp.parts):
             w = self._pixel_weights(ps, ok, r, sigma)
@@ -615,27 +617,27 @@ class Tracker:
         ``prev_frame``) and the key frame, coarse to fine. Raises DegenerateSystem."""
         s = self.settings
         t0 = time.perf_counter()
-        self._scale_to(key)
+        self.scale_to(key)
         est = predicted
         offset = np.zeros(self.n_params)
         total_iters = 0
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
-        for level in reversed(range(self._scales.n_levels())):
-            lvs = self._scales.view_levels(level)
+        for level in reversed(range(self.scales.n_levels())):
+            lvs = self.scales.view_levels(level)
             levels = [self.seq.pyramid(c, frame)[lv] for c, lv in enumerate(lvs)]
             sets = []  # per view, the previous frame's points then the key frame's
             for c, lv in enumerate(lvs):
-                view_sets = [self._point_set(prev, kin_prev, c, prev_frame, lv, 1.0)]
+                view_sets = [self.point_set(prev, kin_prev, c, prev_frame, lv, 1.0)]
                 if s.key_weight > 0 and key_frame != prev_frame:
                     k = (key_frame, c, lv)
-                    if k not in self._key_sets:
-                        self._key_sets[k] = self._point_set(key, kin_key, c, key_frame, lv,
+                    if k not in self.key_sets:
+                        self.key_sets[k] = self.point_set(key, kin_key, c, key_frame, lv,
                                                             s.key_weight)
-                    view_sets.append(self._key_sets[k])
-                sets.append(_PointSet.joined(view_sets))
+                    view_sets.append(self.key_sets[k])
+                sets.append(PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
-            if s.limb_search > 0 and level == self._scales.search_level():
+            if s.limb_search > 0 and level == self.scales.search_level():
                 searched, turned = self._search_limbs(est, frame, key, key_frame)
                 if turned:
                     searched = self._evidenced(est, searched, turned, sets, levels, level)
@@ -644,7 +646,7 @@ class Tracker:
                     kin = Kinematics(self.skeleton, est)
             active = self._active(est, level)
             fgs = self._foregrounds(frame, level, key, key_frame, est, kin)
-            smp = self._sample(est, kin, sets, levels, level, None, fgs)
+            smp = self.sample(est, kin, sets, levels, level, None, fgs)
             sigmas = smp.sigmas
             left = self._left_views(smp)
             if left:
@@ -661,7 +663,7 @@ class Tracker:
                                                                     active)))
                 cand = apply_update(self.skeleton, est, delta, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
-                c_smp = self._sample(cand, kin_c, sets, levels, level, sigmas, fgs)
+                c_smp = self.sample(cand, kin_c, sets, levels, level, sigmas, fgs)
                 # compare on the pixels seen in both poses: a step must not win by hiding pixels
                 both = ~np.isnan(smp.costs) & ~np.isnan(c_smp.costs)
                 old = float(np.sum(smp.costs[both]) + smp.shape_cost + prior @ offset**2)
@@ -718,7 +720,7 @@ class Tracker:
                     "image: check where that view's camera looks and that the pose lines up "
                     "with the footage")
 
-    def _predicted(self, before: BodyPose, last: BodyPose) -> BodyPose:
+    def predict(self, before: BodyPose, last: BodyPose) -> BodyPose:
         """Constant-velocity prediction from the poses of the two frames before, except that a
         limited hinge whose turn would carry it past its limits is predicted where it was:
         carried on, an elbow the limb search had just turned 75 degrees wrapped round past 180
@@ -752,7 +754,7 @@ class Tracker:
             )
         self._check_start(initial, frames[0])
         key_frame, key = frames[0], initial
-        self._key_sets.clear()  # the key pose may differ from an earlier run's
+        self.key_sets.clear()  # the key pose may differ from an earlier run's
         self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it
         blind = depth_blind_joints(self.given_skeleton, initial)
         if self.settings.side_on:
@@ -766,7 +768,7 @@ class Tracker:
                 "away from the camera unseen (only foreshortening shows it): add a view from "
                 "another side, or track side-on, as hinges about the line of sight (Side on "
                 "in the Track settings; side_on in a job)")
-        self._scale_to(initial)
+        self.scale_to(initial)
         first = FrameResult(frame=key_frame, pose=initial.copy(), residual=0.0, iterations=0,
                             converged=True, given=True)
         yield first
@@ -778,7 +780,7 @@ class Tracker:
             prev = history[-1]
             if frame in corrections:
                 key_frame, key = frame, corrections[frame].copy()
-                self._key_sets.clear()
+                self.key_sets.clear()
                 res = FrameResult(frame=frame, pose=key.copy(), residual=0.0, iterations=0,
                                   converged=True, given=True)
                 self.seq.keep_only({(c, frame) for c in range(self.seq.n_views)})
@@ -787,7 +789,7 @@ class Tracker:
                 # the error the correction takes out, which carried on flung the next frames
                 history = history[-1:] + [res] if prev.given else [res]
                 continue
-            pred = (self._predicted(history[-2].pose, prev.pose) if len(history) >= 2
+            pred = (self.predict(history[-2].pose, prev.pose) if len(history) >= 2
                     else prev.pose.copy())
             try:
                 with one_blas_thread():

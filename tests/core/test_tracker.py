@@ -11,9 +11,9 @@ from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapola
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
 from core.skeleton import HINGE, human_template
 from core.tracker import (
+    PointSet,
     Tracker,
     TrackerSettings,
-    _PointSet,
     depth_blind_joints,
     side_on_skeleton,
     track,
@@ -125,8 +125,8 @@ def test_a_body_twice_as_large_is_sampled_and_tracked_as_at_its_own_size(body):
     small_frames = [[render(sk, pose, c)] for c in range(2)]
 
     def points(tracker, p, lv):
-        tracker._scale_to(p)
-        return len(tracker._point_set(p, Kinematics(sk, p), 0, 0, lv, 1.0).value)
+        tracker.scale_to(p)
+        return len(tracker.point_set(p, Kinematics(sk, p), 0, 0, lv, 1.0).value)
 
     small = Tracker(sk, small_frames, CALIBRATED)
     scaled = Tracker(sk, frames, CALIBRATED)
@@ -164,17 +164,17 @@ def test_views_of_different_sizes_each_read_the_level_where_the_body_is_as_large
     small = Tracker(sk, [[render(sk, pose, c)] for c in range(2)], CALIBRATED)
     large = Tracker(sk, [[render(sk, big, c, shape=shapes[1])] for c in range(2)], CALIBRATED)
     for t, p in ((tracker, mixed(pose)), (small, pose), (large, big)):
-        t._scale_to(p)
+        t.scale_to(p)
     assert tracker.seq.levels == [3, 4]
-    assert [tracker._scales.view_level(0, lv) for lv in range(4)] == [0, 0, 1, 2]
-    assert [tracker._scales.view_level(1, lv) for lv in range(4)] == [0, 1, 2, 3]
-    assert tracker._scales.search_level() == large._scales.search_level() == 2
+    assert [tracker.scales.view_level(0, lv) for lv in range(4)] == [0, 0, 1, 2]
+    assert [tracker.scales.view_level(1, lv) for lv in range(4)] == [0, 1, 2, 3]
+    assert tracker.scales.search_level() == large.scales.search_level() == 2
 
     def points(t, p, view, lv):
-        return len(t._point_set(p, Kinematics(sk, p), view, 0, lv, 1.0).value)
+        return len(t.point_set(p, Kinematics(sk, p), view, 0, lv, 1.0).value)
 
     for lv in range(4):
-        own = tracker._scales.view_level(0, lv)
+        own = tracker.scales.view_level(0, lv)
         assert points(tracker, mixed(pose), 0, own) == points(small, pose, 0, own)
         assert points(tracker, mixed(pose), 1, lv) == points(large, big, 1, lv)
 
@@ -216,7 +216,7 @@ def test_the_prediction_holds_a_hinge_that_its_speed_would_carry_past_a_limit(bo
         p.rotations[hip] = se3.exp_so3(np.array([0.1, 0.2, -0.1]) * hip_turn)
         return p
 
-    pred = tracker._predicted(posed(100, 60, 1.0), posed(140, 80, 2.0))
+    pred = tracker.predict(posed(100, 60, 1.0), posed(140, 80, 2.0))
     assert np.degrees(sk.hinge_angle(fast, pred.rotations[fast])) == pytest.approx(140)
     assert np.degrees(sk.hinge_angle(slow, pred.rotations[slow])) == pytest.approx(100)
     np.testing.assert_allclose(pred.rotations[hip], posed(0, 0, 3.0).rotations[hip],
@@ -280,7 +280,7 @@ def test_tracks_backward_and_takes_user_corrections_as_new_keys(body):
     res = track(tracker, pose, [0, 1, 2, 3], corrections={1: fixed})
     assert res.frames[1].iterations == 0
     np.testing.assert_array_equal(res.frames[1].pose.rotations, fixed.rotations)
-    assert {k[0] for k in tracker._key_sets} == {1}  # frame 3 was held against frame 1
+    assert {k[0] for k in tracker.key_sets} == {1}  # frame 3 was held against frame 1
     assert _limb_errors(sk, res.frames[3].pose, p3).max() < 0.5
 
 
@@ -468,8 +468,8 @@ def test_a_joined_point_set_keeps_each_frames_noise_scale(body):
     tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(silhouette=0))
     kin = Kinematics(sk, pose)
     levels = [tracker.seq.pyramid(c, 2)[0] for c in range(3)]
-    prev, key = (tracker._point_set(pose, kin, 0, f, 0, 1.0) for f in (1, 0))
-    apart = tracker._sample(pose, kin, [prev, key], levels, 0).sigmas
-    joined = tracker._sample(pose, kin, [_PointSet.joined([prev, key])], levels, 0).sigmas[0]
+    prev, key = (tracker.point_set(pose, kin, 0, f, 0, 1.0) for f in (1, 0))
+    apart = tracker.sample(pose, kin, [prev, key], levels, 0).sigmas
+    joined = tracker.sample(pose, kin, [PointSet.joined([prev, key])], levels, 0).sigmas[0]
     np.testing.assert_array_equal(joined, np.concatenate(apart))
     assert apart[0][0] > 2 * apart[1][0]  # the noisy frame's scale is its own
