@@ -53,7 +53,7 @@ class _Limb:
     dofs: list  # (joint, local axis, (coarse grid, fine grid)), parents first
 
 
-def _outlines(view: View, A: np.ndarray, C: np.ndarray):
+def outlines(view: View, A: np.ndarray, C: np.ndarray):
     """Each ellipsoid's outline as row spans: centres c (..., 2), row range (..., 2) and the
     forms P (..., 2, 2) of ``raycast.shadows``."""
     c, P = shadows(view, A, C)
@@ -76,7 +76,7 @@ def _inside(box: tuple, outer: tuple) -> bool:
             and box[3] <= outer[3])
 
 
-def _spans(c, half, P, box):
+def spans(c, half, P, box):
     """Per ellipse and box row: the first and one-past-last box column it covers (start ==
     stop where it covers none). Shapes (..., rows)."""
     x0, y0, x1, y1 = box
@@ -91,10 +91,10 @@ def _spans(c, half, P, box):
     return lo.astype(int), hi.astype(int)
 
 
-def _paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tuple) -> None:
+def paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tuple) -> None:
     """Set the pixels of ``mask`` (the box's size) that any ellipsoid's outline covers."""
-    c, half, P = _outlines(view, A, C)
-    lo, hi = _spans(c, half, P, box)
+    c, half, P = outlines(view, A, C)
+    lo, hi = spans(c, half, P, box)
     e, rows = np.nonzero(hi > lo)
     # +1 where a span starts, -1 one past its end: a pixel is covered where the running sum
     # along its row is positive
@@ -104,8 +104,8 @@ def _paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tupl
     mask |= np.cumsum(edges[:, :-1], axis=1) > 0
 
 
-def _sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
-    """Per candidate (K, B blobs each, spans (K, B, rows) from ``_spans``): the sum over its
+def span_sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """Per candidate (K, B blobs each, spans (K, B, rows) from ``spans``): the sum over its
     outline (the union of its blobs' ellipses) of the box image whose row prefix sums are S
     (rows, cols + 1). Overlaps of two ellipses are taken out once; a pixel under three of one
     candidate's is counted twice."""
@@ -183,7 +183,7 @@ class LimbSearch:
         close to its backdrop's (then holes in a limb's outline would make hiding it pay) or
         when the body as a whole is far off."""
         body = np.zeros(fg.shape, bool)
-        _paint(body, view, A, C, (0, 0, fg.shape[1], fg.shape[0]))
+        paint(body, view, A, C, (0, 0, fg.shape[1], fg.shape[0]))
         return float(fg[body].mean()) if body.any() else 0.0
 
     @staticmethod
@@ -193,7 +193,7 @@ class LimbSearch:
         background and -``UNCOVERED_GAIN`` on the foreground."""
         x0, y0, x1, y1 = box
         others = np.zeros((y1 - y0, x1 - x0), bool)
-        _paint(others, view, A, C, box)
+        paint(others, view, A, C, box)
         gain = np.where(others, 0.0, np.where(fg[y0:y1, x0:x1], -UNCOVERED_GAIN, 1.0))
         S = np.zeros((gain.shape[0], gain.shape[1] + 1))
         np.cumsum(gain, axis=1, out=S[:, 1:])
@@ -235,18 +235,18 @@ class LimbSearch:
             for v, (view, fg) in enumerate(zip(views, fgs)):
                 if fg is None:
                     continue
-                c, half, P = _outlines(view, Ak, Ck)
+                c, half, P = outlines(view, Ak, Ck)
                 box = _box(c, half, fg.shape)
                 if box is None:
                     continue
                 if v not in sums or not _inside(box, sums[v][0]):
                     sums[v] = box, self._gain_sums(view, fg, A[rest], C[rest], box)
                 box, S = sums[v]
-                lo, hi = _spans(c, half, P, box)
-                cost += _sums(lo, hi, S)
+                lo, hi = spans(c, half, P, box)
+                cost += span_sums(lo, hi, S)
                 if stage == 0:  # the current pose's outline: the sum of a ramp's increments
                     ramp = np.broadcast_to(np.arange(S.shape[1], dtype=float), S.shape)
-                    area += float(_sums(lo[:1], hi[:1], ramp)[0])
+                    area += float(span_sums(lo[:1], hi[:1], ramp)[0])
             if stage == 0:
                 current = cost[0]
             cost += self.margin * area * np.sum((cands / TURN_SCALE) ** 2, axis=1)

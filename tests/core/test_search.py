@@ -6,7 +6,7 @@ import numpy as np
 from core import raycast, se3
 from core.linearize import Kinematics
 from core.pose import INDEPENDENT, BodyPose, apply_update
-from core.search import LimbSearch, _outlines, _paint, _spans, _sums
+from core.search import LimbSearch, outlines, paint, span_sums, spans
 from core.skeleton import human_template
 from support.synthetic import side_view
 
@@ -34,7 +34,7 @@ def test_outlines_cover_exactly_the_pixels_whose_rays_hit_a_blob():
     A, C = raycast.blob_frames(sk.blobs, g)
     for view in pose.views:
         painted = np.zeros(BODY, bool)
-        _paint(painted, view, A, C, (0, 0, BODY[1], BODY[0]))
+        paint(painted, view, A, C, (0, 0, BODY[1], BODY[0]))
         cast = _covered_by_casting(view, sk, g, BODY)
         assert cast.sum() > 5000
         assert np.sum(painted != cast) <= 2, np.sum(painted != cast)  # round-off on the rim
@@ -55,24 +55,24 @@ def test_outline_sums_count_each_pixel_of_overlapping_blobs_once():
     box = (0, 0, BODY[1], BODY[0])
     for view in pose.views:
         for pair in ([thigh, -1], [shank, -1]):
-            c, half, P = _outlines(view, A[None, pair], C[None, pair])
+            c, half, P = outlines(view, A[None, pair], C[None, pair])
             union = np.zeros(BODY, bool)
-            _paint(union, view, A[pair], C[pair], box)
+            paint(union, view, A[pair], C[pair], box)
             one, other = np.zeros(BODY, bool), np.zeros(BODY, bool)
-            _paint(one, view, A[pair[:1]], C[pair[:1]], box)
-            _paint(other, view, A[pair[1:]], C[pair[1:]], box)
+            paint(one, view, A[pair[:1]], C[pair[:1]], box)
+            paint(other, view, A[pair[1:]], C[pair[1:]], box)
             assert union.sum() < one.sum() + other.sum()  # they overlap
-            lo, hi = _spans(c, half, P, box)
-            np.testing.assert_allclose(_sums(lo, hi, S)[0], img[union].sum(), atol=1e-9)
+            lo, hi = spans(c, half, P, box)
+            np.testing.assert_allclose(span_sums(lo, hi, S)[0], img[union].sum(), atol=1e-9)
             # a ramp's increments count the outline's pixels: its area, as the search takes it
             ramp = np.broadcast_to(np.arange(BODY[1] + 1, dtype=float), S.shape)
-            assert _sums(lo, hi, ramp)[0] == union.sum()
+            assert span_sums(lo, hi, ramp)[0] == union.sum()
 
 
 def _foreground(sk, pose, view):
     A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, pose).segments)
     fg = np.zeros(BODY, bool)
-    _paint(fg, view, A, C, (0, 0, BODY[1], BODY[0]))
+    paint(fg, view, A, C, (0, 0, BODY[1], BODY[0]))
     return fg
 
 
