@@ -98,8 +98,8 @@ def main() -> int:
     # ears, 70 px per metre across the 300 x 200 plates
     print(build_plates(bpy, "muybridge_horse", "QUADRUPED", 300 / 70.2, (0.076, -10.0, 1.193)))
     # the woman (facing right): hips near (85, 193) and feet on the plate's bottom, 160 px per
-    # metre down the 185 x 375 plates; the human turned to face the image's right
-    print(build_plates(bpy, "muybridge_woman", "HUMAN", 375 / 160, (0.044, -10.0, 0.9875),
+    # metre down the plates (padded to 202 x 376); the human turned to face the image's right
+    print(build_plates(bpy, "muybridge_woman", "HUMAN", 376 / 160, (0.097125, -10.0, 0.984375),
                        turn_deg=90))
     return 0
 
