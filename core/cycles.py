@@ -18,6 +18,7 @@ from .errors import InputError
 class CycleError(InputError):
     """Curves that hold no usable cycle, or settings that do not fit them."""
 
+
 def gait_period(curves: np.ndarray, min_frames: int = 4) -> float:
     """Period in frames (sub-frame) of the repetition in ``curves`` (F, C): the first peak of
     the mean normalised autocorrelation past its first zero crossing that reaches 80 % of the

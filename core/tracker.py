@@ -204,9 +204,9 @@ class PointSet:
         if len(sets) == 1:
             return sets[0]
         return PointSet(sets[0].view, *(np.concatenate([getattr(ps, f) for ps in sets])
-                                         for f in ("seg_joint", "blob", "ref", "value",
-                                                   "weight")),
-                         tuple(len(ps.value) for ps in sets))
+                                        for f in ("seg_joint", "blob", "ref", "value",
+                                                  "weight")),
+                        tuple(len(ps.value) for ps in sets))
 
 
 @dataclass
@@ -356,7 +356,7 @@ class Tracker:
             for j, _, _ in limb.dofs:
                 cand.rotations[j] = searched.rotations[j]
             trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
-                                 base.sigmas)
+                                base.sigmas)
             seen = clear = 0
             for c, ps in enumerate(sets):
                 on = moved[ps.seg_joint, limb.joint]
@@ -411,7 +411,7 @@ class Tracker:
 
     # --- point sets ---------------------------------------------------------------------
     def point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
-                   set_weight: float) -> PointSet:
+                  set_weight: float) -> PointSet:
         level = self.seq.pyramid(view, frame)[lv]
         step = self.scales.grid(view, lv)
         v_l = pose.views[view].at_level(lv)
@@ -446,8 +446,8 @@ class Tracker:
 
     # --- one level -----------------------------------------------------------------------
     def sample(self, est: BodyPose, kin: Kinematics, sets: list[PointSet], levels: list,
-                level: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
-                ) -> _Samples:
+               level: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
+               ) -> _Samples:
         """Map every point set into the new frame under ``est``: per-point robust costs (NaN
         where the point is hidden by another blob or off the image) and what the rows need.
         ``levels`` holds each view's pyramid level for tracker level ``level``. Without
@@ -633,7 +633,7 @@ class Tracker:
                     k = (key_frame, c, lv)
                     if k not in self.key_sets:
                         self.key_sets[k] = self.point_set(key, kin_key, c, key_frame, lv,
-                                                            s.key_weight)
+                                                          s.key_weight)
                     view_sets.append(self.key_sets[k])
                 sets.append(PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
