@@ -9,6 +9,8 @@ which rounds sample positions to 1/32 pixel.
 
 from __future__ import annotations
 
+import os
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,13 +41,13 @@ def check_footage(paths, where: str) -> None:
     size from the first, before any is tracked: a file cut short in the middle of a sequence
     must not stop a run half way, and frames of one view are one camera's (cells cropped
     each its own way are not). The decoder's own complaints are kept off the terminal."""
-    files = [p for p in paths if isinstance(p, (str, Path))]
-    size = None
+    size = first = None
     with _quiet_stderr():
-        for p in files:
+        for p in (p for p in paths if isinstance(p, (str, Path))):
             img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
             if img is None:
-                break
+                raise ImageError(f"{p}: cannot read this image ({where}; cut short, or not an "
+                                 "image format): replace it, or leave it out of the footage")
             if size is None:
                 size, first = img.shape, p
             elif img.shape != size:
@@ -53,20 +55,13 @@ def check_footage(paths, where: str) -> None:
                     f"{where}: its images differ in size ({Path(first).name} is "
                     f"{size[1]}x{size[0]}, {Path(p).name} {img.shape[1]}x{img.shape[0]}): "
                     "crop or pad them to one size, lined up as the camera saw them")
-        else:
-            return
-    raise ImageError(f"{p}: cannot read this image ({where}; cut short, or not an image "
-                     "format): replace it, or leave it out of the footage")
 
 
 class _quiet_stderr:
     """Standard error at the file-descriptor level sent nowhere (libpng and libjpeg write to
-    it directly)."""
+    it directly); put back on leaving, an error or not."""
 
     def __enter__(self):
-        import os
-        import sys
-
         sys.stderr.flush()
         self._saved = os.dup(2)
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -74,8 +69,6 @@ class _quiet_stderr:
         os.close(devnull)
 
     def __exit__(self, *exc):
-        import os
-
         os.dup2(self._saved, 2)
         os.close(self._saved)
 
