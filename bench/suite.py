@@ -132,9 +132,8 @@ def score_run(job_path: Path, run: str) -> dict:
     tracker = evaluate.score(sk, names, est, truth, limbs=limbs)
     still = evaluate.score(sk, names, evaluate.held_still(truth), truth, limbs=limbs)
     best = evaluate.score(sk, names, evaluate.best_fit(sk, truth), truth, limbs=limbs)
-    done = sum(not f["diverged"] for f in rep["frames"][1:])  # after the first, as Track
     row = {"tracker": tracker.limb_mean_deg, "still": still.limb_mean_deg,
-           "best": best.limb_mean_deg, "frames": f"{done}/{n - 1}",
+           "best": best.limb_mean_deg, "frames": f"{rep['frames_tracked']}/{n - 1}",
            "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],
            "peak_mb": peak_mb}
     if len(views) == 1:

@@ -72,11 +72,11 @@ def _track(args) -> int:
                   file=sys.stderr)
         return 2
     write_bvh(result_bvh(job, result), args.out)
+    rep = report(job, result, seconds)
     if args.report:
-        write_report(args.report, report(job, result, seconds))
+        write_report(args.report, rep)
     for note in result.notes:
         print(f"note: {note}", file=sys.stderr)
-    rep = report(job, result, seconds)
     print(f"tracked {rep['frames_tracked']} of {rep['frames_total']} frames after the first"
           f" in {seconds:.1f} s -> {args.out}", file=sys.stderr)
     if result.diverged_frames:

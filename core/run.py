@@ -11,7 +11,7 @@ import numpy as np
 
 from .job import Job
 from .pose import world_pose
-from .tracker import FrameResult, Tracker, TrackResult, track
+from .tracker import FrameResult, Tracker, TrackResult, frames_tracked, track
 
 
 def run_job(
@@ -51,7 +51,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
         "views": len(job.images),
         "degrees_of_freedom": len(job.skeleton.dof_names()),
         "frames_total": len(job.images[0]) - 1,
-        "frames_tracked": sum(not f.diverged for f in tracked),
+        "frames_tracked": frames_tracked(result.frames),
         "cancelled": result.cancelled,
         "diverged_frames": result.diverged_frames,
         "notes": result.notes,

@@ -173,6 +173,12 @@ class FrameResult:
     given: bool = False  # the user's pose (the initial one or a correction), not tracked
 
 
+def frames_tracked(results: Sequence[FrameResult]) -> int:
+    """How many of a run's results, in tracking order, were tracked: those after the first
+    (the given pose) that did not diverge. The report and the add-on count the same way."""
+    return sum(not r.diverged for r in results[1:])
+
+
 @dataclass
 class TrackResult:
     frames: list[FrameResult] = field(default_factory=list)

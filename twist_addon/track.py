@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import bpy
 
 from ..core.pose import BodyPose, world_pose
-from ..core.tracker import FrameResult, Tracker
+from ..core.tracker import FrameResult, Tracker, frames_tracked
 from . import keyframes
 from .armature_action import ArmatureAction
 from .bridge import (
@@ -107,9 +107,8 @@ class TrackSession:
 
 
 def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
-    done = [r for r in session.tracked[1:] if not r.diverged]
     diverged = [session.frames[r.frame] for r in session.tracked if r.diverged]
-    msg = f"tracked {len(done)} of {len(session.frames) - 1} frames"
+    msg = f"tracked {frames_tracked(session.tracked)} of {len(session.frames) - 1} frames"
     if cancelled:
         msg += " (stopped; the tracked frames are kept)"
     kept = [session.frames[i] for i in session.corrections
@@ -159,7 +158,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
         if error:
             self.report({"ERROR"}, error)
         result, tracked = context.scene.twist.result, self._session.tracked
-        result.frames_tracked = sum(1 for r in tracked[1:] if not r.diverged)
+        result.frames_tracked = frames_tracked(tracked)
         result.last_residual = tracked[-1].residual if len(tracked) > 1 else 0.0
         result.diverged_frames = ", ".join(
             f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
