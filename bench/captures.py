@@ -51,7 +51,7 @@ NAMINGS = {
 }
 # each naming's joints as the CMU 131 walk names their body parts: the rendered body's
 # radii (walk_footage.RADII) are given by those names
-_SIDES = {"Left": "Left", "Right": "Right"}
+_SIDES = ("Left", "Right")
 AS_CMU131 = {
     "cmu131": {},
     "cmu_motionbuilder": {

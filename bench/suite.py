@@ -107,9 +107,23 @@ def write_job(clip_dir: Path, look: str, run: str, settings: dict) -> Path:
     return path
 
 
+_REFERENCES: dict[tuple[Path, str], tuple[float, float]] = {}  # (clip folder, run)
+
+
+def references(clip_dir: Path, run: str, sk, truth: tuple, limbs) -> tuple[float, float]:
+    """Held still and the best fit of the tracked joints, over the run's frames: the same for
+    every look of a clip, so fitted once per clip and run."""
+    key = (clip_dir, run)
+    if key not in _REFERENCES:
+        names = sk.tracked_joint_names()
+        _REFERENCES[key] = tuple(
+            evaluate.score(sk, names, pose, truth, limbs=limbs).limb_mean_deg
+            for pose in (evaluate.held_still(truth), evaluate.best_fit(sk, truth)))
+    return _REFERENCES[key]
+
+
 def score_run(job_path: Path, run: str) -> dict:
-    """Track one job and score it; the references are computed here too (cheap beside the
-    tracking, and each run's own frames)."""
+    """Track one job and score it beside the references of its clip and run."""
     views, step, _ = RUNS[run]
     out = job_path.with_suffix(".bvh")
     rep_path = job_path.with_suffix(".report.json")
@@ -128,12 +142,10 @@ def score_run(job_path: Path, run: str) -> dict:
         pad = n - len(est[0])
         est = (np.concatenate([est[0], np.repeat(est[0][-1:], pad, 0)]),
                np.concatenate([est[1], np.repeat(est[1][-1:], pad, 0)]))
-    names = sk.tracked_joint_names()
-    tracker = evaluate.score(sk, names, est, truth, limbs=limbs)
-    still = evaluate.score(sk, names, evaluate.held_still(truth), truth, limbs=limbs)
-    best = evaluate.score(sk, names, evaluate.best_fit(sk, truth), truth, limbs=limbs)
-    row = {"tracker": tracker.limb_mean_deg, "still": still.limb_mean_deg,
-           "best": best.limb_mean_deg, "frames": f"{rep['frames_tracked']}/{n - 1}",
+    tracker = evaluate.score(sk, sk.tracked_joint_names(), est, truth, limbs=limbs)
+    still, best = references(job_path.parent, run, sk, truth, limbs)
+    row = {"tracker": tracker.limb_mean_deg, "still": still, "best": best,
+           "frames": f"{rep['frames_tracked']}/{n - 1}",
            "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],
            "peak_mb": peak_mb}
     if len(views) == 1:
