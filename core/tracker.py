@@ -111,7 +111,8 @@ class TrackerSettings:
     limb_search: float = _knob(0.1, "Before refining a frame, turn each limb over a grid of "
                                "angles against the silhouette and keep the best turn when it "
                                "beats the prediction by this share of the limb's outline, "
-                               "and by that again per 45 degrees of turn squared (0: off). "
+                               "and by that again per 45 degrees of turn squared, and every "
+                               "view whose pixels see the limb bears the turn out (0: off). "
                                "Catches limbs faster than a blob's width a frame")
 
     def __post_init__(self):
