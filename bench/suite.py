@@ -47,6 +47,7 @@ from suite_footage import (  # noqa: E402
 )
 from walk_benchmark import track_job  # noqa: E402
 
+from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
@@ -122,6 +123,31 @@ def references(clip_dir: Path, run: str, sk, truth: tuple, limbs) -> tuple[float
     return _REFERENCES[key]
 
 
+BAD_LIMB_DEG = 20.0  # a limb this far off the capture is one the flags should catch
+
+
+def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, int, int]:
+    """How the report's limb flags match the truth over the eight limbs and the tracked
+    frames: (flagged and over ``BAD_LIMB_DEG`` off, over it, flagged). A limb's flag is its
+    segment's (the nearest joint above the limb's first joint that the report names)."""
+    bad = flagged = caught = 0
+    ve = evaluate.limb_vectors(sk, *est, limbs)
+    vt = evaluate.limb_vectors(sk, *truth, limbs)
+    for fr in rep["frames"]:
+        if not fr["limbs"]:
+            continue
+        f = fr["frame"]
+        for label, a, _ in limbs[:8]:
+            segment = next(sk.names[j] for j in sk.ancestors(sk.index(a))
+                           if sk.names[j] in fr["limbs"])
+            off = np.degrees(se3.angle_between_vectors(ve[label][f], vt[label][f]))
+            flag = bool(fr["limbs"][segment]["flag"])
+            bad += off > BAD_LIMB_DEG
+            flagged += flag
+            caught += flag and off > BAD_LIMB_DEG
+    return caught, bad, flagged
+
+
 def score_run(job_path: Path, run: str) -> dict:
     """Track one job and score it beside the references of its clip and run."""
     views, step, _ = RUNS[run]
@@ -147,12 +173,16 @@ def score_run(job_path: Path, run: str) -> dict:
     row = {"tracker": tracker.limb_mean_deg, "still": still, "best": best,
            "frames": f"{rep['frames_tracked']}/{n - 1}",
            "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],
-           "peak_mb": peak_mb}
+           "peak_mb": peak_mb, "flags": flag_counts(rep, sk, est, truth, limbs)}
     if len(views) == 1:
         height_px = sk.height() * PIXELS_PER_METRE
         px = evaluate.image_error_px(sk, est, truth, job.cameras, limbs)
         row["image_pct"] = 100 * px / height_px
     return row
+
+
+def _share(part: int, whole: int) -> str:
+    return f"{100 * part / whole:.0f} %" if whole else "-"
 
 
 def table(rows: dict, runs: list[str]) -> list[str]:
@@ -165,8 +195,9 @@ def table(rows: dict, runs: list[str]) -> list[str]:
                    f" {r['best']:.1f}° | {r['frames']}{' (stopped)' if r['diverged'] else ''}"
                    f" | {img} |")
     out += ["", "| run | median | worst | median over best fit | worst over best fit |"
-            " beats held still | stopped | median image err | tracking fps | peak memory |",
-            "|---|---|---|---|---|---|---|---|---|---|"]
+            " beats held still | stopped | median image err | flags catch | flags right |"
+            " tracking fps | peak memory |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for run in runs:
         rs = [r for (_, _, rn), r in rows.items() if rn == run]
         if not rs:
@@ -174,12 +205,14 @@ def table(rows: dict, runs: list[str]) -> list[str]:
         err = [r["tracker"] for r in rs]
         over = [r["tracker"] - r["best"] for r in rs]
         img = [r["image_pct"] for r in rs if "image_pct" in r]
+        caught, bad, flagged = np.sum([r["flags"] for r in rs], axis=0)
         out.append(
             f"| {run} | {statistics.median(err):.1f}° | {max(err):.1f}° |"
             f" {statistics.median(over):+.1f}° | {max(over):+.1f}° |"
             f" {sum(r['tracker'] < r['still'] for r in rs)}/{len(rs)} |"
             f" {sum(r['diverged'] for r in rs)} |"
             f" {f'{statistics.median(img):.1f} %' if img else ''} |"
+            f" {_share(caught, bad)} of {bad} | {_share(caught, flagged)} of {flagged} |"
             f" {statistics.median(r['fps'] for r in rs):.1f} |"
             f" {max(r['peak_mb'] for r in rs):.0f} MB |")
     return out

@@ -68,6 +68,10 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
                 "reason": f.reason,
                 "seconds": f.seconds,
                 "given": f.given,
+                "limbs": {name: {"confidence": round(c.confidence, 3), "flag": c.flag,
+                                 "views": [None if v is None else round(v, 3)
+                                           for v in c.views]}
+                          for name, c in f.limbs.items()},
             }
             for f in result.frames
         ],

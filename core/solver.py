@@ -58,10 +58,16 @@ def mixture_cost(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np
     return np.log1p(outlier) - np.log(np.exp(-0.5 * (r / sigma) ** 2) + outlier)
 
 
-def support_weights(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
-    """IRLS weights of :func:`mixture_cost`: the inlier posterior over sigma^2 (EM E-step)."""
+def support_posterior(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
+    """Per pixel, the posterior that it follows its blob under :func:`mixture_cost`'s
+    mixture (the EM E-step): 1 / (1 + outlier) at r = 0, toward 0 far out."""
     g = np.exp(-0.5 * (r / sigma) ** 2)
-    return g / (g + outlier) / sigma**2
+    return g / (g + outlier)
+
+
+def support_weights(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
+    """IRLS weights of :func:`mixture_cost`: the inlier posterior over sigma^2."""
+    return support_posterior(r, sigma, outlier) / sigma**2
 
 
 def robust_scale(r: np.ndarray, floor: float) -> float:

@@ -32,6 +32,7 @@ from . import image as imagelib
 from . import raycast, se3
 from . import silhouette as sil
 from .blas import one_blas_thread
+from .confidence import MIN_LIMB_POINTS, LimbCheck, Limbs
 from .errors import InputError
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
@@ -45,6 +46,7 @@ from .solver import (
     mixture_cost,
     robust_scale,
     solve,
+    support_posterior,
     support_weights,
 )
 
@@ -52,7 +54,6 @@ SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equat
 BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
 ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
 MIN_LEVEL_PIXELS = 16  # the coarsest pyramid level keeps images at least this large
-MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its points are visible there
 
 
 def _knob(default, doc: str):
@@ -172,6 +173,7 @@ class FrameResult:
     reason: str = ""
     seconds: float = 0.0
     given: bool = False  # the user's pose (the initial one or a correction), not tracked
+    limbs: dict[str, LimbCheck] = field(default_factory=dict)  # tracked frames: each limb's
 
 
 def frames_tracked(results: Sequence[FrameResult]) -> int:
@@ -226,6 +228,7 @@ class _Samples:
     sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
     shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
+    labels: list = field(default_factory=list)  # per view: the label map sampled against
 
 
 class Tracker:
@@ -269,6 +272,7 @@ class Tracker:
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
         self._search = LimbSearch(skeleton, self.settings.limb_search)
+        self._limbs = Limbs(skeleton, self._blobs.joint)
 
     def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
@@ -509,7 +513,8 @@ class Tracker:
             costs.append(c)
             parts.append((ok, q[ok], vals[ok, 1:3], r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
-                        measured if sigmas is None else sigmas, shape_cost, shape_parts)
+                        measured if sigmas is None else sigmas, shape_cost, shape_parts,
+                        labels)
 
     def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
                        ) -> np.ndarray:
@@ -569,6 +574,24 @@ class Tracker:
             num += float(np.sum(w * r * r))
             den += float(np.sum(w))
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
+
+    def _limb_checks(self, sets: list[PointSet], smp: _Samples, fgs: list | None
+                     ) -> dict[str, LimbCheck]:
+        """Each limb's confidence at the sampled pose (``core.confidence``): per view, its
+        mapped pixels' support (1 for a perfect match) and its outline on the silhouette."""
+        top = 1 + self.settings.outlier_density
+        per_view = []
+        for c, (ps, sigma, (ok, _, _, r)) in enumerate(zip(sets, smp.sigmas, smp.parts)):
+            support = np.full(len(ps.value), np.nan)
+            support[ok] = np.minimum(
+                top * support_posterior(r, sigma[ok], self.settings.outlier_density), 1.0)
+            labels, fg = smp.labels[c], None
+            if fgs is not None and fgs[c] is not None:
+                crop, (x0, y0), _ = fgs[c]
+                fg = np.zeros(labels.shape, bool)
+                fg[y0:y0 + crop.shape[0], x0:x0 + crop.shape[1]] = crop
+            per_view.append(self._limbs.view_agreement(ps.blob, support, labels, fg))
+        return self._limbs.checks(per_view)
 
     def _trust(self, delta: np.ndarray) -> np.ndarray:
         """The step shortened so that no joint turns more than ``max_step`` degrees: far from
@@ -693,7 +716,8 @@ class Tracker:
                         converged = True  # no step lowers the cost: a minimum at this level
                         break
         result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
-                             iterations=total_iters, converged=converged)
+                             iterations=total_iters, converged=converged,
+                             limbs=self._limb_checks(sets, smp, fgs))
         left = self._left_views(smp)
         if left:
             result.diverged, result.reason = True, left

@@ -1,0 +1,109 @@
+"""Per-limb confidence: which limb a blob belongs to, each view's agreement against a loop
+over the pixels, and a limb the footage no longer shows flagged by the real tracker."""
+
+import copy
+
+import numpy as np
+import pytest
+
+from core.confidence import MIN_LIMB_POINTS, UNSEEN, UNSURE, UNSURE_FLAG, Limbs
+from core.pose import CALIBRATED, BodyPose
+from core.skeleton import human_template
+from core.tracker import Tracker, TrackerSettings, track
+from support.synthetic import render, side_view
+
+
+@pytest.fixture(scope="module")
+def template():
+    return human_template()
+
+
+def _limbs(sk):
+    return Limbs(sk, np.array([b.joint for b in sk.blobs]))
+
+
+def test_a_blob_belongs_to_the_deepest_tracked_joint_that_moves_it(template):
+    sk = template
+    limbs = _limbs(sk)
+    moved = sk.moved_by()
+    tracked = set(sk.tracked_joint_names())
+    assert set(limbs.names) <= tracked
+    for b, blob in enumerate(sk.blobs):
+        above = [sk.names[j] for j in sk.ancestors(blob.joint) if sk.names[j] in tracked]
+        if not above:
+            assert limbs.of_blob[b] == -1  # the trunk: the root's
+        else:
+            name = limbs.names[limbs.of_blob[b]]
+            assert name == above[0]  # ancestors run from the blob's joint up
+            assert moved[blob.joint, sk.index(name)]
+
+
+def test_view_agreement_is_each_seen_limbs_mean_support_times_its_outline_on_the_silhouette(
+        template):
+    limbs = _limbs(template)
+    L, B = len(limbs), len(template.blobs)
+    rng = np.random.default_rng(3)
+    blob = rng.integers(0, B, 600)
+    support = rng.uniform(0, 1, 600)
+    support[rng.uniform(size=600) < 0.3] = np.nan
+    labels = rng.integers(-1, B, (40, 30))
+    fg = rng.uniform(size=(40, 30)) < 0.6
+    got = limbs.view_agreement(blob, support, labels, fg)
+    plain = limbs.view_agreement(blob, support)
+    for i in range(L):
+        mine = [s for b, s in zip(blob, support) if limbs.of_blob[b] == i and s == s]
+        cover = [f for lab, f in zip(labels.ravel(), fg.ravel())
+                 if lab >= 0 and limbs.of_blob[lab] == i]
+        if len(mine) < MIN_LIMB_POINTS:
+            assert np.isnan(got[i]) and np.isnan(plain[i])
+            continue
+        assert plain[i] == pytest.approx(np.mean(mine))
+        share = np.mean(cover) if cover else 1.0
+        assert got[i] == pytest.approx(np.mean(mine) * share)
+
+
+def test_a_limb_is_as_sure_as_its_worst_seeing_view_and_unseen_when_no_view_sees_it(
+        template):
+    limbs = _limbs(template)
+    a = np.full(len(limbs), 0.9)
+    b = np.full(len(limbs), 0.9)
+    a[0], b[0] = 0.8, 0.3  # one view disagrees
+    a[1], b[1] = np.nan, 0.7  # seen in one view only
+    a[2] = b[2] = np.nan  # seen in none
+    checks = limbs.checks([a, b])
+    first, second, third = (checks[n] for n in limbs.names[:3])
+    assert first.confidence == pytest.approx(0.3) and first.flag == UNSURE_FLAG
+    assert first.views == pytest.approx((0.8, 0.3))
+    assert second.confidence == pytest.approx(0.7) and second.flag == ""
+    assert second.views[0] is None
+    assert third.confidence == 0.0 and third.flag == UNSEEN
+    assert all(checks[n].flag == "" for n in limbs.names[3:])
+    assert UNSURE > 0.3
+
+
+def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
+    """Three views of a still body; in the new frame the left forearm is gone from every
+    view (painted as background): its pixels match no more and its outline lies off the
+    silhouette; the limbs of the other side and the legs are trusted."""
+    sk = copy.deepcopy(template)
+    sk.limits[:] = [-np.inf, np.inf]
+    views = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                    views)
+    limbs = _limbs(sk)
+    gone = "LeftElbow"
+    without = copy.deepcopy(sk)
+    without.blobs = [b for b, i in zip(sk.blobs, limbs.of_blob)
+                     if i < 0 or limbs.names[i] != gone]
+    frames = [[render(sk, pose, c, noise=0.01, seed=c),
+               render(without, pose, c, noise=0.01, seed=10 + c)] for c in range(3)]
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose, [0, 1])
+    assert res.frames[0].limbs == {}  # the given pose is not judged
+    checks = res.frames[1].limbs
+    assert set(checks) == set(limbs.names)
+    assert checks[gone].flag == UNSURE_FLAG, checks[gone]
+    chain = {sk.names[j] for j in sk.ancestors(sk.index(gone))}  # the upper arm shared
+    for name, check in checks.items():  # its pixels and may be flagged too
+        if name not in chain:
+            assert check.flag == "" and check.confidence > checks[gone].confidence + 0.3, (
+                name, check)
