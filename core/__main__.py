@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 
 from .bvh import write_bvh
+from .confidence import frame_list
 from .errors import InputError
 from .init_fit import FitError, fit_pose, least_certain
 from .job import JobError, load_fit, load_job
@@ -55,7 +56,8 @@ def _track(args) -> int:
     def progress(res, done, total):
         done_so_far.frames.append(res)
         if not args.quiet:
-            flag = f"  DIVERGED: {res.reason}" if res.diverged else ""
+            flag = f"  DIVERGED: {res.reason}" if res.diverged else "".join(
+                f"  {name} {why}" for name, why in res.flagged.items())
             print(f"frame {res.frame:4d}  {done}/{total}  residual {res.residual:.4f}"
                   f"  iterations {res.iterations}{flag}", file=sys.stderr)
 
@@ -79,6 +81,11 @@ def _track(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     print(f"tracked {rep['frames_tracked']} of {rep['frames_total']} frames after the first"
           f" in {seconds:.1f} s -> {args.out}", file=sys.stderr)
+    check = result.frames_to_check
+    if check:
+        print(f"check {len(check)} frames where a limb's pixels or outline disagree with a "
+              f"view, or no view sees it: {frame_list(check)} (the report names the limbs)",
+              file=sys.stderr)
     if result.diverged_frames:
         f = result.diverged_frames[0]
         print(f"stopped: frame {f} diverged ({result.frames[-1].reason}); correct the pose"

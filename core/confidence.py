@@ -1,17 +1,19 @@
-"""How far to trust each limb of a tracked frame: what each view's pixels and outline say.
+"""How far to trust each limb of a tracked frame: what each view's pixels and silhouette say.
 
 A limb is a tracked joint with the blobs it moves that no tracked joint below it moves (an
 upper arm without the forearm). On a tracked frame, in each view, the limb's body pixels of
 the earlier frames, mapped into the new frame, either follow it in brightness (their EM
 support posterior near 1) or do not; and where the view has a still backdrop, the limb's
-outline (its blobs' pixels that are front-most) lies on the body's silhouette or on the
-backdrop. A view *sees* the limb when at least ``MIN_LIMB_POINTS`` of its pixels are
-visible there; its agreement is the mean support of those pixels (scaled so that a perfect
-match reads 1) times the share of the outline on the silhouette. The limb's confidence is
-its worst seeing view's agreement: every view that sees a limb must bear it out, as every
-view's evidence is needed to move it. A limb no view sees has confidence 0 and is flagged
-``unseen`` (its pose is the prediction, held); one whose confidence is under ``UNSURE`` is
-flagged ``unsure``: fewer than half of what it shows agrees with the footage.
+bone (points along its blobs' long axes, so that a blob fatter than the limb costs
+nothing) lies on the body's silhouette or off it. A view *sees* the limb when at least
+``MIN_LIMB_POINTS`` of its pixels are visible there; its agreement is the mean support of
+those pixels (scaled so that a perfect match reads 1) times the share of the bone on the
+silhouette. The limb's confidence is its worst seeing view's agreement: every view that
+sees a limb must bear it out, as every view's evidence is needed to move it. A limb no view
+sees has confidence 0 and is flagged ``unseen`` (its pose is the prediction, held); one
+whose confidence is under ``UNSURE`` is flagged ``unsure``: less than half of what it shows
+agrees with the footage. A limb over another body part in every view reads as agreeing
+(its bone is on the silhouette there): the flag misses it.
 """
 
 from __future__ import annotations
@@ -21,10 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .raycast import BlobStack
 from .skeleton import BALL, HINGE, Skeleton
 
 MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its pixels are visible there
 UNSURE = 0.5  # a limb is flagged below this confidence
+AXIS_POINTS = 9  # points along each blob's long axis whose silhouette is read
+AXIS_REACH = 0.8  # of the blob's long radius, either side of its centre
 UNSEEN, UNSURE_FLAG = "unseen", "unsure"
 
 
@@ -44,10 +49,23 @@ class LimbCheck:
         return UNSURE_FLAG if self.confidence < UNSURE else ""
 
 
+def frame_list(frames) -> str:
+    """Frame numbers as short text, runs joined: ``3, 5-9, 12``."""
+    frames = sorted(frames)
+    runs = []
+    for f in frames:
+        if runs and f == runs[-1][1] + 1:
+            runs[-1][1] = f
+        else:
+            runs.append([f, f])
+    return ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
+
+
 class Limbs:
     """The limbs of a skeleton and which limb each blob belongs to."""
 
-    def __init__(self, skeleton: Skeleton, blob_joint: np.ndarray):
+    def __init__(self, skeleton: Skeleton, blobs: BlobStack):
+        blob_joint = blobs.joint
         moved = skeleton.moved_by()
         tracked = [j for j in range(skeleton.n_joints) if skeleton.kinds[j] in (BALL, HINGE)]
         depth = np.array([len(skeleton.ancestors(j)) for j in range(skeleton.n_joints)])
@@ -61,30 +79,36 @@ class Limbs:
         self.names = [skeleton.names[j] for j in joints]
         index = {j: i for i, j in enumerate(joints)}
         self.of_blob = np.array([index.get(int(j), -1) for j in owner], dtype=int)
+        # points along each limb blob's longest axis, in its segment's frame: where the
+        # bone runs whatever the blob's girth
+        t = np.linspace(-AXIS_REACH, AXIS_REACH, AXIS_POINTS)
+        mine = np.flatnonzero(self.of_blob >= 0)
+        longest = blobs.radii[mine].argmax(axis=1)
+        axis = blobs.Q[mine, :, longest] * blobs.radii[mine, longest, None]
+        self.axis_joint = np.repeat(blob_joint[mine], len(t))
+        self.axis_ref = (blobs.centre[mine, None] + axis[:, None] * t[:, None]).reshape(-1, 3)
+        self.axis_limb = np.repeat(self.of_blob[mine], len(t))
 
     def __len__(self) -> int:
         return len(self.names)
 
     def view_agreement(self, point_blob: np.ndarray, support: np.ndarray,
-                       labels: np.ndarray | None = None, fg: np.ndarray | None = None
-                       ) -> np.ndarray:
+                       axis_on: np.ndarray | None = None) -> np.ndarray:
         """One view's agreement per limb (L,), NaN where the view does not see the limb.
         ``point_blob`` (N,): each mapped pixel's blob; ``support`` (N,): its support in
-        [0, 1], NaN where it is hidden or off the image. ``labels``: the view's label map
-        at the frame's pose (front-most blob, -1 where none) and ``fg`` the foreground on
-        the same pixels (boolean), or None without a still backdrop."""
+        [0, 1], NaN where it is hidden or off the image. ``axis_on``: per point of
+        ``axis_ref`` at the frame's pose, 1 where the view's foreground holds it, 0 where
+        not, NaN off the image; None without a still backdrop."""
         L = len(self)
         limb = self.of_blob[point_blob]
         use = (limb >= 0) & ~np.isnan(support)
         count = np.bincount(limb[use], minlength=L)
         total = np.bincount(limb[use], weights=support[use], minlength=L)
         agree = np.where(count >= MIN_LIMB_POINTS, total / np.maximum(count, 1), np.nan)
-        if labels is not None and fg is not None:
-            covered = labels >= 0
-            lab = self.of_blob[labels[covered]]
-            on = lab >= 0
-            area = np.bincount(lab[on], minlength=L)
-            hit = np.bincount(lab[on], weights=fg[covered][on], minlength=L)
+        if axis_on is not None:
+            use = ~np.isnan(axis_on)
+            area = np.bincount(self.axis_limb[use], minlength=L)
+            hit = np.bincount(self.axis_limb[use], weights=axis_on[use], minlength=L)
             agree *= np.where(area > 0, hit / np.maximum(area, 1), 1.0)
         return agree
 

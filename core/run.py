@@ -54,6 +54,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
         "frames_tracked": frames_tracked(result.frames),
         "cancelled": result.cancelled,
         "diverged_frames": result.diverged_frames,
+        "frames_to_check": sorted(result.frames_to_check),
         "notes": result.notes,
         "seconds": seconds,
         "frames_per_second": len(tracked) / seconds if seconds > 0 else None,

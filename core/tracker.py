@@ -175,6 +175,11 @@ class FrameResult:
     given: bool = False  # the user's pose (the initial one or a correction), not tracked
     limbs: dict[str, LimbCheck] = field(default_factory=dict)  # tracked frames: each limb's
 
+    @property
+    def flagged(self) -> dict[str, str]:
+        """The limbs to check on this frame and why (``LimbCheck.flag``)."""
+        return {name: c.flag for name, c in self.limbs.items() if c.flag}
+
 
 def frames_tracked(results: Sequence[FrameResult]) -> int:
     """How many of a run's results, in tracking order, were tracked: those after the first
@@ -191,6 +196,11 @@ class TrackResult:
     @property
     def diverged_frames(self) -> list[int]:
         return [f.frame for f in self.frames if f.diverged]
+
+    @property
+    def frames_to_check(self) -> dict[int, dict[str, str]]:
+        """Tracked frames with limbs flagged, and those limbs' flags."""
+        return {f.frame: f.flagged for f in self.frames if f.flagged and not f.diverged}
 
 
 @dataclass
@@ -228,7 +238,6 @@ class _Samples:
     sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
     shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
-    labels: list = field(default_factory=list)  # per view: the label map sampled against
 
 
 class Tracker:
@@ -272,7 +281,7 @@ class Tracker:
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
         self._search = LimbSearch(skeleton, self.settings.limb_search)
-        self._limbs = Limbs(skeleton, self._blobs.joint)
+        self._limbs = Limbs(skeleton, self._blobs)
 
     def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
@@ -513,8 +522,7 @@ class Tracker:
             costs.append(c)
             parts.append((ok, q[ok], vals[ok, 1:3], r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
-                        measured if sigmas is None else sigmas, shape_cost, shape_parts,
-                        labels)
+                        measured if sigmas is None else sigmas, shape_cost, shape_parts)
 
     def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
                        ) -> np.ndarray:
@@ -575,22 +583,29 @@ class Tracker:
             den += float(np.sum(w))
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
 
-    def _limb_checks(self, sets: list[PointSet], smp: _Samples, fgs: list | None
-                     ) -> dict[str, LimbCheck]:
-        """Each limb's confidence at the sampled pose (``core.confidence``): per view, its
-        mapped pixels' support (1 for a perfect match) and its outline on the silhouette."""
+    def _limb_checks(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
+                     fgs: list | None) -> dict[str, LimbCheck]:
+        """Each limb's confidence at the finest level's pose ``kin`` (``core.confidence``):
+        per view, its mapped pixels' support (1 for a perfect match) and how much of its
+        bone lies on the silhouette."""
         top = 1 + self.settings.outlier_density
+        axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
         per_view = []
         for c, (ps, sigma, (ok, _, _, r)) in enumerate(zip(sets, smp.sigmas, smp.parts)):
             support = np.full(len(ps.value), np.nan)
             support[ok] = np.minimum(
                 top * support_posterior(r, sigma[ok], self.settings.outlier_density), 1.0)
-            labels, fg = smp.labels[c], None
+            on = None
             if fgs is not None and fgs[c] is not None:
-                crop, (x0, y0), _ = fgs[c]
-                fg = np.zeros(labels.shape, bool)
-                fg[y0:y0 + crop.shape[0], x0:x0 + crop.shape[1]] = crop
-            per_view.append(self._limbs.view_agreement(ps.blob, support, labels, fg))
+                crop, (x0, y0), _ = fgs[c]  # on every g-th pixel of the view's level
+                lv = self.scales.view_level(c, 0)
+                g = self.scales.grid(c, lv)
+                px = np.rint(kin.pose.views[c].at_level(lv).project(axis) / g).astype(int)
+                px -= (x0, y0)
+                inside = ((px >= 0) & (px < (crop.shape[1], crop.shape[0]))).all(axis=1)
+                on = np.full(len(px), np.nan)
+                on[inside] = crop[px[inside, 1], px[inside, 0]]
+            per_view.append(self._limbs.view_agreement(ps.blob, support, on))
         return self._limbs.checks(per_view)
 
     def _trust(self, delta: np.ndarray) -> np.ndarray:
@@ -717,7 +732,7 @@ class Tracker:
                         break
         result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
                              iterations=total_iters, converged=converged,
-                             limbs=self._limb_checks(sets, smp, fgs))
+                             limbs=self._limb_checks(kin, sets, smp, fgs))
         left = self._left_views(smp)
         if left:
             result.diverged, result.reason = True, left

@@ -122,6 +122,14 @@ class TWIST_PT_results(_TwistPanel, bpy.types.Panel):
         layout.prop(result, "last_residual")
         if result.diverged_frames:
             layout.label(text="Stopped at frame " + result.diverged_frames, icon="ERROR")
+        if result.frames_to_check:
+            col = layout.column(align=True)
+            for i, line in enumerate(textwrap.wrap("Check frames " + result.frames_to_check,
+                                                   NOTE_WIDTH)):
+                col.label(text=line, icon="ERROR" if i == 0 else "BLANK1")
+            row = layout.row(align=True)
+            row.operator("screen.marker_jump", text="Previous", icon="TRIA_LEFT").next = False
+            row.operator("screen.marker_jump", text="Next", icon="TRIA_RIGHT").next = True
         for note in result.notes.splitlines():
             col = layout.column(align=True)
             for i, line in enumerate(textwrap.wrap(note, NOTE_WIDTH, break_on_hyphens=False)):

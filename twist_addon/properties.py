@@ -100,6 +100,9 @@ class TWIST_PG_result(bpy.types.PropertyGroup):
         description="RMS brightness error of the last tracked frame (0 to 1)")
     diverged_frames: bpy.props.StringProperty(
         name="Diverged", description="Frames where the last run stopped, and why")
+    frames_to_check: bpy.props.StringProperty(
+        name="Frames to Check", description="Tracked frames where a limb's pixels or outline "
+        "disagree with a view, or no view sees the limb (marked on the timeline)")
     notes: bpy.props.StringProperty(
         name="Notes", description="What the tracker noted about the last run, one note a "
         "line (a view whose backdrop moves, joints one line of sight cannot see turn)")

@@ -11,9 +11,10 @@ from dataclasses import dataclass, field
 
 import bpy
 
+from ..core.confidence import frame_list
 from ..core.pose import BodyPose, world_pose
 from ..core.tracker import FrameResult, Tracker, frames_tracked
-from . import keyframes
+from . import checks, keyframes
 from .armature_action import ArmatureAction
 from .bridge import (
     BridgeError,
@@ -91,8 +92,13 @@ class TrackSession:
         R, root = pose_from_armature(arm, sk)
         self.initial = BodyPose(R, root, self.initial.views)
 
-    def run(self):
-        """Yield after each frame is tracked and keyed."""
+    def frames_to_check(self) -> list[int]:
+        """Scene frames tracked with a limb flagged."""
+        return [self.frames[r.frame] for r in self.tracked if r.flagged and not r.diverged]
+
+    def run(self, scene):
+        """Yield after each frame is tracked and keyed, and marked on the timeline when a
+        limb is flagged there (an earlier run's marker on it replaced)."""
         sk = self.tracker.given_skeleton  # the armature's joints, whatever side-on tracks
         steps = self.tracker.iter_track(self.initial, range(len(self.frames)),
                                         self.corrections)
@@ -102,6 +108,7 @@ class TrackSession:
                 R, root = world_pose(self.tracker.mode, self.initial.views[0], res.pose)
                 keyframes.write_pose(self.armature, sk, frame, R, root,
                                      self.user_keys.get(frame, frozenset()))
+                checks.mark(scene, frame, res.flagged)
             self.tracked.append(res)
             yield res
 
@@ -121,12 +128,16 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
     notes = session.tracker.notes
     if notes:
         msg += "; " + "; ".join(notes)
+    check = session.frames_to_check()
+    if check:
+        msg += (f"; check frame{'s' * (len(check) > 1)} {frame_list(check)}: a limb's pixels "
+                "or outline disagree with a view, or no view sees it (marked on the timeline)")
     if diverged:
         last = session.tracked[-1]
         msg += f"; stopped at frame {diverged[0]}: {last.reason}. Pose the armature there, " \
                "Key Correction, and track again"
         return {"WARNING"}, msg
-    return ({"WARNING"} if notes else {"INFO"}), msg
+    return ({"WARNING"} if notes or check else {"INFO"}), msg
 
 
 class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
@@ -146,7 +157,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
             self.report({"ERROR"}, str(e))
             return False
         self._session.keep_start_pose(context.scene)
-        self._steps = self._session.run()
+        self._steps = self._session.run(context.scene)
         return True
 
     def _finish(self, context, cancelled: bool = False, error: str = "") -> set:
@@ -163,6 +174,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
         result.diverged_frames = ", ".join(
             f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
         result.notes = "\n".join(self._session.tracker.notes)
+        result.frames_to_check = frame_list(self._session.frames_to_check())
         context.scene.frame_set(context.scene.frame_current)
         if not (cancelled or error):
             return {"FINISHED"}
@@ -229,8 +241,8 @@ class TWIST_OT_key_correction(ArmatureAction, bpy.types.Operator):
 
 
 class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
-    """Remove the keyframes tracking wrote on the armature, and no other, and give the bones
-    back the pose they had before Track"""
+    """Remove the keyframes tracking wrote on the armature, and no other, and its frames-to-
+    check markers, and give the bones back the pose they had before Track"""
 
     bl_idname = "twist.clear_track"
     bl_label = "Clear Track"
@@ -239,6 +251,8 @@ class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
         arm = context.scene.twist.armature
         n = keyframes.clear(arm, skeleton_from_armature(arm))
         keyframes.restore_pose(arm)
+        checks.unmark(context.scene)
+        context.scene.twist.result.frames_to_check = ""
         context.scene.frame_set(context.scene.frame_current)  # user keys decide where left
         return f"removed {n} tracked keyframes from '{arm.name}'"
 

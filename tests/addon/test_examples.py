@@ -30,3 +30,25 @@ def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, fr
         twist_addon.bridge.view_from_camera(v.camera, scene)  # orthographic, square pixels
     sk = twist_addon.bridge.skeleton_from_armature(tw.armature)
     assert len(sk.dof_names()) >= 10 and sk.blobs
+
+
+def test_an_unposed_template_tracked_says_which_frames_to_check(bpy_module, registered):
+    """The horse's template is not posed over its plate: Track keys the frames but warns,
+    lists them in the Results panel and marks them on the timeline; Clear Track takes its
+    markers away and leaves the user's."""
+    bpy = bpy_module
+    bpy.ops.wm.open_mainfile(filepath=str(EXAMPLES / "muybridge_horse.blend"))
+    scene = bpy.context.scene
+    scene.timeline_markers.new("stride", frame=5)  # the user's own
+    scene.frame_set(scene.frame_start)
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    result = scene.twist.result
+    assert result.frames_to_check
+    checks = registered.twist_addon.checks
+    ours = {m.frame: m.name for m in scene.timeline_markers if m.name.startswith(checks.PREFIX)}
+    listed = registered.core.confidence.frame_list(ours)
+    assert listed == result.frames_to_check
+    assert len(ours) >= (scene.frame_end - scene.frame_start) // 2, ours
+    assert bpy.ops.twist.clear_track() == {"FINISHED"}
+    assert [m.name for m in scene.timeline_markers] == ["stride"]
+    assert result.frames_to_check == ""

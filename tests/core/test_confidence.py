@@ -6,8 +6,9 @@ import copy
 import numpy as np
 import pytest
 
-from core.confidence import MIN_LIMB_POINTS, UNSEEN, UNSURE, UNSURE_FLAG, Limbs
+from core.confidence import MIN_LIMB_POINTS, UNSEEN, UNSURE, UNSURE_FLAG, Limbs, frame_list
 from core.pose import CALIBRATED, BodyPose
+from core.raycast import BlobStack
 from core.skeleton import human_template
 from core.tracker import Tracker, TrackerSettings, track
 from support.synthetic import render, side_view
@@ -19,7 +20,7 @@ def template():
 
 
 def _limbs(sk):
-    return Limbs(sk, np.array([b.joint for b in sk.blobs]))
+    return Limbs(sk, BlobStack.of(sk.blobs))
 
 
 def test_a_blob_belongs_to_the_deepest_tracked_joint_that_moves_it(template):
@@ -38,7 +39,7 @@ def test_a_blob_belongs_to_the_deepest_tracked_joint_that_moves_it(template):
             assert moved[blob.joint, sk.index(name)]
 
 
-def test_view_agreement_is_each_seen_limbs_mean_support_times_its_outline_on_the_silhouette(
+def test_view_agreement_is_each_seen_limbs_mean_support_times_its_bone_on_the_silhouette(
         template):
     limbs = _limbs(template)
     L, B = len(limbs), len(template.blobs)
@@ -46,20 +47,35 @@ def test_view_agreement_is_each_seen_limbs_mean_support_times_its_outline_on_the
     blob = rng.integers(0, B, 600)
     support = rng.uniform(0, 1, 600)
     support[rng.uniform(size=600) < 0.3] = np.nan
-    labels = rng.integers(-1, B, (40, 30))
-    fg = rng.uniform(size=(40, 30)) < 0.6
-    got = limbs.view_agreement(blob, support, labels, fg)
+    on = (rng.uniform(size=len(limbs.axis_ref)) < 0.6).astype(float)
+    on[rng.uniform(size=len(on)) < 0.2] = np.nan  # off the image
+    got = limbs.view_agreement(blob, support, on)
     plain = limbs.view_agreement(blob, support)
     for i in range(L):
         mine = [s for b, s in zip(blob, support) if limbs.of_blob[b] == i and s == s]
-        cover = [f for lab, f in zip(labels.ravel(), fg.ravel())
-                 if lab >= 0 and limbs.of_blob[lab] == i]
+        bone = [x for x, k in zip(on, limbs.axis_limb) if k == i and x == x]
         if len(mine) < MIN_LIMB_POINTS:
             assert np.isnan(got[i]) and np.isnan(plain[i])
             continue
         assert plain[i] == pytest.approx(np.mean(mine))
-        share = np.mean(cover) if cover else 1.0
+        share = np.mean(bone) if bone else 1.0
         assert got[i] == pytest.approx(np.mean(mine) * share)
+
+
+def test_a_limbs_bone_runs_along_its_blobs_long_axes(template):
+    """The bone's points lie on each limb blob's long axis, inside the blob."""
+    limbs = _limbs(template)
+    stack = BlobStack.of(template.blobs)
+    for i, name in enumerate(limbs.names):
+        pts = limbs.axis_ref[limbs.axis_limb == i]
+        blobs = np.flatnonzero(limbs.of_blob == i)
+        assert len(pts) == len(blobs) * 9
+        for b in blobs:  # every blob's own points: inside it, on one line through its centre
+            u = np.einsum("ab,na->nb", stack.to_unit[b], pts - stack.centre[b])
+            mine = np.linalg.norm(u, axis=1) < 1
+            assert mine.sum() >= 9
+            rank = np.linalg.matrix_rank(pts[mine][:9] - stack.centre[b], tol=1e-9)
+            assert rank == 1, name
 
 
 def test_a_limb_is_as_sure_as_its_worst_seeing_view_and_unseen_when_no_view_sees_it(
@@ -107,3 +123,9 @@ def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
         if name not in chain:
             assert check.flag == "" and check.confidence > checks[gone].confidence + 0.3, (
                 name, check)
+
+
+@pytest.mark.parametrize("frames, text", [
+    ([], ""), ([4], "4"), ([3, 5, 6, 7, 8, 9, 12], "3, 5-9, 12"), ([2, 1], "1-2")])
+def test_frame_lists_join_runs(frames, text):
+    assert frame_list(frames) == text

@@ -93,6 +93,16 @@ def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path, mode):
     assert report["frames_tracked"] == report["frames_total"] == 2  # after the first
     assert report["diverged_frames"] == []
     assert {"frame", "residual", "iterations", "converged", "seconds"} <= set(report["frames"][1])
+    assert report["frames"][0]["limbs"] == {}  # the given pose is not judged
+    for fr in report["frames"][1:]:  # every tracked joint's confidence, per view too
+        assert set(fr["limbs"]) == set(sk.tracked_joint_names())
+        for check in fr["limbs"].values():
+            assert 0 <= check["confidence"] <= 1 and len(check["views"]) == 3
+            assert check["flag"] in ("", "unsure", "unseen")
+    flagged = [fr["frame"] for fr in report["frames"] if any(
+        c["flag"] for c in fr["limbs"].values())]
+    assert report["frames_to_check"] == flagged
+    assert ("check " in proc.stderr) == bool(flagged)
 
 
 @pytest.mark.parametrize("flag", ["--out", "--report"])
@@ -108,8 +118,9 @@ def test_an_output_folder_that_does_not_exist_stops_the_run_before_it_starts(foo
     assert "frame" not in proc.stderr and not any(tmp_path.iterdir())  # nothing tracked
 
 
-def test_a_diverged_runs_report_is_strict_json_and_its_bvh_ends_before_it(footage,
-                                                                          tmp_path):
+def test_the_report_is_strict_json_with_limb_checks_and_its_bvh_ends_before_a_divergence(
+        footage, tmp_path):
+    from core.confidence import LimbCheck
     from core.run import report, result_bvh, write_report
     from core.tracker import FrameResult, TrackResult
 
@@ -118,14 +129,21 @@ def test_a_diverged_runs_report_is_strict_json_and_its_bvh_ends_before_it(footag
     result = TrackResult([
         FrameResult(frame=0, pose=job.initial, residual=0.0, iterations=0, converged=True,
                     given=True),
-        FrameResult(frame=1, pose=job.initial, residual=float("nan"), iterations=0,
+        FrameResult(frame=1, pose=job.initial, residual=0.01, iterations=3, converged=True,
+                    limbs={"LeftKnee": LimbCheck(0.2, (0.2, None, 0.9)),
+                           "RightKnee": LimbCheck(0.8, (0.8, 0.9, 0.9))}),
+        FrameResult(frame=2, pose=job.initial, residual=float("nan"), iterations=0,
                     converged=False, diverged=True, reason="the body left the image")])
     write_report(tmp_path / "report.json", report(job, result, 1.0))
     rep = json.loads((tmp_path / "report.json").read_text(),
                      parse_constant=lambda c: pytest.fail(f"{c} is not JSON"))
-    assert rep["frames"][1]["residual"] is None and rep["diverged_frames"] == [1]
-    assert (rep["frames_tracked"], rep["frames_total"]) == (0, 2)
-    assert len(result_bvh(job, result).motion) == 1
+    assert rep["frames"][2]["residual"] is None and rep["diverged_frames"] == [2]
+    assert (rep["frames_tracked"], rep["frames_total"]) == (1, 2)
+    assert len(result_bvh(job, result).motion) == 2
+    assert rep["frames_to_check"] == [1]
+    assert rep["frames"][1]["limbs"] == {
+        "LeftKnee": {"confidence": 0.2, "flag": "unsure", "views": [0.2, None, 0.9]},
+        "RightKnee": {"confidence": 0.8, "flag": "", "views": [0.8, 0.9, 0.9]}}
 
 
 def test_an_image_that_cannot_be_read_is_named_before_any_frame_is_tracked(footage, tmp_path):
