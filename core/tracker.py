@@ -32,7 +32,7 @@ from . import image as imagelib
 from . import raycast, se3
 from . import silhouette as sil
 from .blas import one_blas_thread
-from .confidence import MIN_LIMB_POINTS, LimbCheck, Limbs
+from .confidence import MIN_LIMB_POINTS, UNSEEN, LimbCheck, Limbs
 from .errors import InputError
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
@@ -766,12 +766,17 @@ class Tracker:
                     "image: check where that view's camera looks and that the pose lines up "
                     "with the footage")
 
-    def predict(self, before: BodyPose, last: BodyPose) -> BodyPose:
+    def predict(self, before: BodyPose, last: BodyPose, held: Sequence[str] = ()) -> BodyPose:
         """Constant-velocity prediction from the poses of the two frames before, except that a
         limited hinge whose turn would carry it past its limits is predicted where it was:
         carried on, an elbow the limb search had just turned 75 degrees wrapped round past 180
-        and came out bent backward; stopped at the limit, it was 30 degrees off."""
+        and came out bent backward; stopped at the limit, it was 30 degrees off. The joints
+        ``held`` (limbs no view saw on the last frame) are predicted where they were: the
+        footage did not show their motion."""
         pred = extrapolate(before, last, self.settings.prediction_gain)
+        for name in held:
+            j = self.skeleton.index(name)
+            pred.rotations[j] = last.rotations[j]
         for k in self._limited:
             j, axis = self._dof_joint[k], self._dof_axis[k]
             step = se3.log_so3(before.rotations[j].T @ last.rotations[j]) @ axis
@@ -835,7 +840,8 @@ class Tracker:
                 # the error the correction takes out, which carried on flung the next frames
                 history = history[-1:] + [res] if prev.given else [res]
                 continue
-            pred = (self.predict(history[-2].pose, prev.pose) if len(history) >= 2
+            unseen = [n for n, why in prev.flagged.items() if why == UNSEEN]
+            pred = (self.predict(history[-2].pose, prev.pose, unseen) if len(history) >= 2
                     else prev.pose.copy())
             try:
                 with one_blas_thread():
