@@ -83,9 +83,9 @@ def _track(args) -> int:
           f" in {seconds:.1f} s -> {args.out}", file=sys.stderr)
     check = result.frames_to_check
     if check:
-        print(f"check {len(check)} frames where a limb's pixels or outline disagree with a "
-              f"view, or no view sees it: {frame_list(check)} (the report names the limbs)",
-              file=sys.stderr)
+        print(f"check {len(check)} frames where a view disagrees with a limb (its pixels, or "
+              f"its bone off the silhouette) or no view sees it: {frame_list(check)} (the "
+              "report names the limbs)", file=sys.stderr)
     if result.diverged_frames:
         f = result.diverged_frames[0]
         print(f"stopped: frame {f} diverged ({result.frames[-1].reason}); correct the pose"

@@ -101,8 +101,9 @@ class TWIST_PG_result(bpy.types.PropertyGroup):
     diverged_frames: bpy.props.StringProperty(
         name="Diverged", description="Frames where the last run stopped, and why")
     frames_to_check: bpy.props.StringProperty(
-        name="Frames to Check", description="Tracked frames where a limb's pixels or outline "
-        "disagree with a view, or no view sees the limb (marked on the timeline)")
+        name="Frames to Check", description="Tracked frames where a view disagrees with a limb "
+        "(its pixels, or its bone off the silhouette) or no view sees it (marked on the "
+        "timeline)")
     notes: bpy.props.StringProperty(
         name="Notes", description="What the tracker noted about the last run, one note a "
         "line (a view whose backdrop moves, joints one line of sight cannot see turn)")

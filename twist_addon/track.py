@@ -130,8 +130,9 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
         msg += "; " + "; ".join(notes)
     check = session.frames_to_check()
     if check:
-        msg += (f"; check frame{'s' * (len(check) > 1)} {frame_list(check)}: a limb's pixels "
-                "or outline disagree with a view, or no view sees it (marked on the timeline)")
+        msg += (f"; check frame{'s' * (len(check) > 1)} {frame_list(check)}: a view disagrees "
+                "with a limb (its pixels, or its bone off the silhouette) or no view sees it "
+                "(marked on the timeline)")
     if diverged:
         last = session.tracked[-1]
         msg += f"; stopped at frame {diverged[0]}: {last.reason}. Pose the armature there, " \
