@@ -2,12 +2,15 @@
 
     twist-mocap track JOB.json --out TRACKED.bvh [--report REPORT.json]
     twist-mocap fit FIT.json --out FITTED.bvh
+    twist-mocap plate PLATE.png --out FOLDER [--per-row N]
 
 (``python -m core`` with the project's Python does the same.) A job names the body (a BVH
 and the joints to track), the first frame's pose, each view's footage and camera, and
-settings; docs/JOB_FORMAT.md describes every field. Exit status: 0 done; 2 the job, its
-footage or the output paths are unusable, or the clicks cannot determine a fit (nothing
-written); 3 tracking stopped at a diverged frame (the frames before it are written).
+settings; docs/JOB_FORMAT.md describes every field. ``plate`` cuts a printed plate (cells
+in rows with dark gutters) into one image per cell, lined up on the ground line, named
+PLATE_01.png, PLATE_02.png, ... in reading order. Exit status: 0 done; 2 the job, its
+footage or the output paths are unusable, the clicks cannot determine a fit, or the
+plate's cells cannot be found (nothing written); 3 tracking stopped at a diverged frame (the frames before it are written).
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from .confidence import frame_list
 from .errors import InputError
 from .init_fit import FitError, fit_pose, least_certain
 from .job import JobError, load_fit, load_job
+from .plate import write_frames
 from .pose import world_pose
 from .run import report, result_bvh, timed_run, write_report
 from .tracker import TrackResult
@@ -117,6 +121,27 @@ def _fit(args) -> int:
     return 0
 
 
+def _plate(args) -> int:
+    if not Path(args.plate).is_file():
+        print(f"error: {args.plate}: no such image", file=sys.stderr)
+        return 2
+    problem = _writable(args.out, "frames' folder")  # the folder itself is made
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
+    try:
+        cells, paths = write_frames(args.plate, args.out, args.per_row)
+    except InputError as e:
+        print(f"error: {args.plate}: {e}", file=sys.stderr)
+        return 2
+    rows = len({c.box[1] for c in cells})
+    print(f"{len(cells)} cells in {rows} rows -> {paths[0].name} ... {paths[-1].name} in "
+          f"{args.out}; each cell's offset down from the first's: "
+          f"{', '.join(f'{c.offset[1]:+.1f}' for c in cells)} px",
+          file=sys.stderr)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="twist-mocap", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -129,8 +154,14 @@ def main(argv=None) -> int:
     f = sub.add_parser("fit", help="fit the first pose and body proportions to clicked joints")
     f.add_argument("job", help="the fit file (JSON)")
     f.add_argument("--out", required=True, help="the BVH to write: fitted offsets, one frame")
+    pl = sub.add_parser("plate", help="cut a printed plate into its cells, registered, as "
+                        "an image sequence")
+    pl.add_argument("plate", help="the plate's image")
+    pl.add_argument("--out", required=True, help="the folder to write the frames into")
+    pl.add_argument("--per-row", type=int, help="cells per row, where the plate's cells "
+                    "touch with no gutter between them and their count is not found")
     args = ap.parse_args(argv)
-    return _track(args) if args.command == "track" else _fit(args)
+    return {"track": _track, "fit": _fit, "plate": _plate}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -42,7 +42,7 @@ def check_footage(paths, where: str) -> None:
     must not stop a run half way, and frames of one view are one camera's (cells cropped
     each its own way are not). The decoder's own complaints are kept off the terminal."""
     size = first = None
-    with _quiet_stderr():
+    with quiet_stderr():
         for p in (p for p in paths if isinstance(p, (str, Path))):
             img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
             if img is None:
@@ -57,7 +57,7 @@ def check_footage(paths, where: str) -> None:
                     "crop or pad them to one size, lined up as the camera saw them")
 
 
-class _quiet_stderr:
+class quiet_stderr:
     """Standard error at the file-descriptor level sent nowhere (libpng and libjpeg write to
     it directly); put back on leaving, an error or not."""
 
