@@ -186,12 +186,15 @@ def import_plate(grey: np.ndarray, per_row: int | None = None
 def write_frames(plate: str | Path, out: str | Path, per_row: int | None = None
                  ) -> tuple[list[Cell], list[Path]]:
     """Import the plate file and write its frames as ``<plate name>_01.png``, ... into the
-    folder ``out`` (made if missing); returns the cells and the files."""
+    folder ``out`` (made if missing; an earlier import's frames there are replaced);
+    returns the cells and the files."""
     plate, out = Path(plate), Path(out)
     with quiet_stderr():  # libpng's warnings on digitised plates' colour profiles
         grey = load_grey(plate)
     cells, frames = import_plate(grey, per_row)
     out.mkdir(parents=True, exist_ok=True)
+    for old in out.glob(f"{plate.stem}_[0-9][0-9].png"):  # an earlier import's, maybe more
+        old.unlink()
     paths = []
     for i, frame in enumerate(frames, 1):
         path = out / f"{plate.stem}_{i:02d}.png"

@@ -51,6 +51,8 @@ class TWIST_PT_views(_TwistPanel, bpy.types.Panel):
         col = row.column(align=True)
         col.operator("twist.add_view", icon="ADD", text="")
         col.operator("twist.remove_view", icon="REMOVE", text="")
+        col.separator()
+        col.operator("twist.add_plate_view", icon="IMAGE_DATA", text="")
         if tw.views:
             view = tw.views[tw.active_view]
             layout.prop(view, "first_frame")

@@ -1,7 +1,8 @@
 """Views: a camera per view with its footage behind it, added and removed, and the footage's
 image for each scene frame.
 
-Operator ids are a public contract: ``twist.add_view``, ``twist.remove_view``."""
+Operator ids are a public contract: ``twist.add_view``, ``twist.add_plate_view``,
+``twist.remove_view``."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from pathlib import Path
 
 import bpy
 
+from ..core.errors import InputError
+from ..core.plate import write_frames
 from ..core.video import VideoFrames, is_video
 from .bridge import BridgeError
 from .properties import first_frame_property
@@ -39,6 +42,65 @@ def footage_frames(view_pg, frames: list[int]) -> list:
     return paths.select(indices)
 
 
+def add_footage_view(context, path: Path, first_frame: int) -> str:
+    """Add a view of the footage ``path`` (a movie, or any image of a sequence: its folder's
+    images of the same kind, in name order) from ``first_frame``: an orthographic camera
+    looking along +y with the footage behind it; the first view sets the scene's frame
+    range and resolution, a later one shortens the range to its footage. Returns what was
+    done; BridgeError when Blender cannot read the file."""
+    movie = is_video(path)
+    pattern = str(path) if movie else str(path.parent / f"*{path.suffix}")
+    try:
+        if movie:
+            source = bpy.data.movieclips.load(str(path), check_existing=True)
+            count, (img_w, img_h) = source.frame_duration, source.size
+            if not count:
+                bpy.data.movieclips.remove(source)
+                raise RuntimeError("no frames")
+        else:
+            count = len(glob.glob(pattern))
+            source = bpy.data.images.load(str(path), check_existing=True)
+            img_w, img_h = source.size  # a sequence reports no size until it is shown
+    except RuntimeError:
+        raise BridgeError(f"{path.name}: Blender cannot read it as a movie or an image; "
+                          "pick a movie file or any image of an image sequence") from None
+    scene = context.scene
+    n = len(scene.twist.views) + 1
+    cam_data = bpy.data.cameras.new(f"View {n}")
+    cam_data.type = "ORTHO"
+    cam_data.show_background_images = True
+    cam = bpy.data.objects.new(f"View {n}", cam_data)
+    context.collection.objects.link(cam)
+    cam.location = (0.0, -10.0, 1.0)
+    cam.rotation_euler = (1.5707963, 0.0, 0.0)  # looking along +y, z up: a side view
+    bg = cam_data.background_images.new()
+    bg.frame_method = "FIT"
+    if movie:
+        source.frame_start = first_frame
+        bg.source, bg.clip = "MOVIE_CLIP", source
+    else:
+        source.source = "SEQUENCE" if count > 1 else "FILE"
+        bg.image = source
+        bg.image_user.frame_start = first_frame
+        bg.image_user.frame_duration = count
+    if img_w and img_h and n == 1:
+        scene.render.resolution_x, scene.render.resolution_y = img_w, img_h
+    view = scene.twist.views.add()
+    view.camera = cam
+    view.images = bpy.path.relpath(pattern) if bpy.data.filepath else pattern
+    view.first_frame = first_frame
+    scene.twist.active_view = len(scene.twist.views) - 1
+    last = first_frame + count - 1
+    message = f"added '{cam.name}' with {count} frames"
+    if n == 1:  # the scene's range is the footage's
+        scene.frame_start, scene.frame_end = first_frame, last
+        message += f"; the scene's frames are now {first_frame}-{last}"
+    elif scene.frame_end > last:  # every view must have an image for every frame
+        scene.frame_end = max(last, scene.frame_start)
+        message += f"; the scene now ends at frame {scene.frame_end}, where its footage does"
+    return message
+
+
 class TWIST_OT_add_view(bpy.types.Operator):
     """Add a view: an orthographic camera with the footage behind it, one image per frame"""
 
@@ -61,58 +123,54 @@ class TWIST_OT_add_view(bpy.types.Operator):
         if not path.is_file():
             self.report({"ERROR"}, f"{self.filepath}: no such image or movie file")
             return {"CANCELLED"}
-        movie = is_video(path)
-        pattern = str(path) if movie else str(path.parent / f"*{path.suffix}")
         try:
-            if movie:
-                source = bpy.data.movieclips.load(str(path), check_existing=True)
-                count, (img_w, img_h) = source.frame_duration, source.size
-                if not count:
-                    bpy.data.movieclips.remove(source)
-                    raise RuntimeError("no frames")
-            else:
-                count = len(glob.glob(pattern))
-                source = bpy.data.images.load(str(path), check_existing=True)
-                img_w, img_h = source.size  # a sequence reports no size until it is shown
-        except RuntimeError:
-            self.report({"ERROR"}, f"{path.name}: Blender cannot read it as a movie or an "
-                        "image; pick a movie file or any image of an image sequence")
+            message = add_footage_view(context, path, self.first_frame)
+        except BridgeError as e:
+            self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
-        scene = context.scene
-        n = len(scene.twist.views) + 1
-        cam_data = bpy.data.cameras.new(f"View {n}")
-        cam_data.type = "ORTHO"
-        cam_data.show_background_images = True
-        cam = bpy.data.objects.new(f"View {n}", cam_data)
-        context.collection.objects.link(cam)
-        cam.location = (0.0, -10.0, 1.0)
-        cam.rotation_euler = (1.5707963, 0.0, 0.0)  # looking along +y, z up: a side view
-        bg = cam_data.background_images.new()
-        bg.frame_method = "FIT"
-        if movie:
-            source.frame_start = self.first_frame
-            bg.source, bg.clip = "MOVIE_CLIP", source
-        else:
-            source.source = "SEQUENCE" if count > 1 else "FILE"
-            bg.image = source
-            bg.image_user.frame_start = self.first_frame
-            bg.image_user.frame_duration = count
-        if img_w and img_h and n == 1:
-            scene.render.resolution_x, scene.render.resolution_y = img_w, img_h
-        view = scene.twist.views.add()
-        view.camera = cam
-        view.images = bpy.path.relpath(pattern) if bpy.data.filepath else pattern
-        view.first_frame = self.first_frame
-        scene.twist.active_view = len(scene.twist.views) - 1
-        last = self.first_frame + count - 1
-        message = f"added '{cam.name}' with {count} frames"
-        if n == 1:  # the scene's range is the footage's
-            scene.frame_start, scene.frame_end = self.first_frame, last
-            message += f"; the scene's frames are now {self.first_frame}-{last}"
-        elif scene.frame_end > last:  # every view must have an image for every frame
-            scene.frame_end = max(last, scene.frame_start)
-            message += f"; the scene now ends at frame {scene.frame_end}, where its footage does"
         self.report({"INFO"}, message)
+        return {"FINISHED"}
+
+
+class TWIST_OT_add_plate_view(bpy.types.Operator):
+    """Add a view from a printed plate: its cells cut out, lined up on the ground line and
+    written as an image sequence beside the plate, then added as the view's footage"""
+
+    bl_idname = "twist.add_plate_view"
+    bl_label = "Add View from Plate"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: bpy.props.StringProperty(
+        name="Plate", subtype="FILE_PATH",
+        description="The plate's image: cells in rows with dark gutters between the rows")
+    per_row: bpy.props.IntProperty(
+        name="Cells per Row", min=0, default=0,
+        description="How many cells each row holds (0: found from the plate; give it where "
+                    "the cells touch with no gutter between them)")
+    first_frame: first_frame_property()
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        plate = Path(bpy.path.abspath(self.filepath))
+        if not plate.is_file():
+            self.report({"ERROR"}, f"{self.filepath}: no such image file")
+            return {"CANCELLED"}
+        out = plate.parent / f"{plate.stem}_frames"
+        try:
+            cells, paths = write_frames(plate, out, self.per_row or None)
+            message = add_footage_view(context, paths[0], self.first_frame)
+        except (InputError, BridgeError) as e:
+            self.report({"ERROR"}, f"{plate.name}: {e}")
+            return {"CANCELLED"}
+        except OSError as e:
+            self.report({"ERROR"}, f"cannot write the plate's frames into {out} ({e.strerror})"
+                        ": copy the plate into a folder you can write to")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"{plate.name}: {len(cells)} cells cut into {out.name}/; "
+                    + message)
         return {"FINISHED"}
 
 
@@ -134,4 +192,4 @@ class TWIST_OT_remove_view(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (TWIST_OT_add_view, TWIST_OT_remove_view)
+CLASSES = (TWIST_OT_add_view, TWIST_OT_add_plate_view, TWIST_OT_remove_view)

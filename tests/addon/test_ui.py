@@ -1,10 +1,15 @@
 """The sidebar panels drawn into a recording stand-in layout, and adding and removing views."""
 
+import shutil
+from pathlib import Path
+
 import cv2
 import numpy as np
 import pytest
 
 from support.layout import draw_panel
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_panels_draw_existing_properties_and_operators(bpy_module, registered, tmp_path):
@@ -38,7 +43,8 @@ def test_panels_draw_existing_properties_and_operators(bpy_module, registered, t
             "frames_tracked", "first_frame"} <= drawn_props
     assert {"twist.track", "twist.clear_track", "twist.add_view", "twist.remove_view",
             "twist.add_template_armature", "twist.smooth_track", "twist.make_cycle",
-            "twist.retarget", "twist.load_bone_map", "twist.edit_bone_map"} <= drawn_ops
+            "twist.retarget", "twist.load_bone_map", "twist.edit_bone_map",
+            "twist.add_plate_view"} <= drawn_ops
 
 
 def test_add_and_remove_views(bpy_module, registered, tmp_path):
@@ -106,3 +112,22 @@ def test_track_without_an_armature_says_why_it_cannot_run(bpy_module, registered
     assert not bpy.ops.twist.track.poll()
     with pytest.raises(RuntimeError, match="Set the armature to track first"):
         bpy.ops.twist.track()
+
+
+def test_a_plate_becomes_a_view_of_its_cells(bpy_module, registered, tmp_path):
+    """Add View from Plate cuts the plate beside itself and adds the cells as the view's
+    frames; the scene's range is the cells'; a file that is no plate is refused."""
+    bpy = bpy_module
+    plate = tmp_path / "plate_camel.png"
+    shutil.copy(ROOT / "example_blends" / "muybridge_plates" / plate.name, plate)
+    assert bpy.ops.twist.add_plate_view(filepath=str(plate), first_frame=1) == {"FINISHED"}
+    scene = bpy.context.scene
+    (view,) = scene.twist.views
+    frames = registered.twist_addon.views.footage_frames(view, list(range(1, 11)))
+    assert [Path(f).name for f in frames] == [f"plate_camel_{i:02d}.png" for i in range(1, 11)]
+    assert (scene.frame_start, scene.frame_end) == (1, 10)
+    blank = tmp_path / "blank.png"
+    cv2.imwrite(str(blank), np.full((60, 90), 200, np.uint8))
+    with pytest.raises(RuntimeError, match="blank.png: found fewer than two cells"):
+        bpy.ops.twist.add_plate_view(filepath=str(blank))
+    assert len(scene.twist.views) == 1
