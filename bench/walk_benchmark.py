@@ -47,7 +47,7 @@ from walk_footage import (  # noqa: E402
 
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
-from core.tracker import side_on_skeleton  # noqa: E402
+from core.side_on import side_on_skeleton  # noqa: E402
 
 THREE = ["lateral", "endon", "oblique60"]
 # one view on the stretch where the walker crosses it (the clip's first 22 frames at 15 fps

@@ -25,6 +25,7 @@ BODY_MARGIN = 6  # full-resolution pixels the key frame's body is painted out be
 INPAINT_RADIUS = 6  # pixels around a painted-out pixel its value is drawn from (the cost
 # grows with its square: at the margin of a body 800 pixels tall, 24, it took 2 s a view)
 STILL_AREA_RATIO = 4.0  # a backdrop holds while frames' foreground stays under this x body
+BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
 
 
 class Backdrop:
@@ -152,3 +153,62 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
         return Mismatch(np.zeros((0, 2)), np.zeros((0, 2)), cost, np.zeros(0))
     return Mismatch(np.concatenate(model), np.concatenate(target), cost,
                     np.concatenate(weight))
+
+
+class SilhouetteCue:
+    """One run's silhouette state: each view's backdrop, learned from the key frame the
+    first time it is asked for and then from every tracked frame, and the foregrounds of
+    the frame being tracked. The tracker says where the body is (its blobs' pixels, full
+    resolution); this object knows only images. A view whose footage around the body keeps
+    changing (a moving camera or light) has no backdrop, and a note says so."""
+
+    def __init__(self, seq):
+        self.seq = seq  # the run's ImageSequence
+        self.backdrops: list[Backdrop | None] | None = None  # per view; None: not started
+        self._foregrounds: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
+
+    def reset(self) -> None:
+        """Forget the backdrops (a new key pose, or a new size of the body's pyramids)."""
+        self.backdrops, self._foregrounds = None, {}
+
+    @property
+    def started(self) -> bool:
+        return self.backdrops is not None
+
+    def start(self, key_frame: int, bodies: list[np.ndarray], margins: list[int]) -> list[str]:
+        """Each view's backdrop from the key frame with the body (``bodies``: per view, its
+        pixels on the key frame) painted out ``margins`` pixels wide, checked against frames
+        spread over the footage; returns the notes on views whose backdrop does not hold."""
+        others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
+        self.backdrops, notes = [], []
+        for c, (body, margin) in enumerate(zip(bodies, margins)):
+            backdrop = Backdrop(self.seq.grey(c, key_frame), body, (
+                self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})), margin)
+            if not backdrop.still:
+                notes.append(f"view {c + 1}: the footage around the body changes from frame "
+                             "to frame far more than a body's outline (a moving camera or "
+                             "light, or a first pose that does not cover the body), so its "
+                             "silhouette is not used")
+            self.backdrops.append(backdrop if backdrop.still else None)
+        return notes
+
+    def has(self, view: int) -> bool:
+        """Whether ``view`` has a still backdrop (after ``start``)."""
+        return self.backdrops is not None and self.backdrops[view] is not None
+
+    def foreground(self, view: int, frame: int) -> np.ndarray:
+        """Full-resolution 0/1 foreground of ``frame`` in ``view`` (one that ``has``); only
+        one frame's are kept."""
+        if (view, frame) not in self._foregrounds:
+            self._foregrounds = {k: v for k, v in self._foregrounds.items() if k[1] == frame}
+            self._foregrounds[view, frame] = self.backdrops[view].foreground(
+                self.seq.grey(view, frame))
+        return self._foregrounds[view, frame]
+
+    def unseen(self, view: int) -> bool:
+        """Whether ``view``'s backdrop still has pixels only painted in."""
+        return self.has(view) and bool(self.backdrops[view].unseen.any())
+
+    def learn(self, view: int, frame: int, body: np.ndarray) -> None:
+        """Let ``view``'s backdrop see what ``frame`` shows away from the body there."""
+        self.backdrops[view].learn(self.seq.grey(view, frame), body)

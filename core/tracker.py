@@ -37,8 +37,9 @@ from .errors import InputError
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from .scales import REFERENCE_BODY_PIXELS, Scales
-from .search import SIDE_ON, LimbSearch
+from .search import LimbSearch
 from .sequence import ImageSequence
+from .side_on import depth_blind_joints, side_on_skeleton
 from .skeleton import HINGE, Skeleton
 from .solver import (
     DegenerateSystem,
@@ -51,8 +52,6 @@ from .solver import (
 )
 
 SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
-BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
-ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
 MIN_LEVEL_PIXELS = 16  # the coarsest pyramid level keeps images at least this large
 
 
@@ -120,44 +119,6 @@ class TrackerSettings:
         for name in ("levels", "iterations", "pixel_step"):
             if int(getattr(self, name)) < 1:
                 raise InputError(f"settings.{name} must be a whole number >= 1")
-
-
-def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
-    """Names of the tracked joints that turn their limbs toward or away from the cameras
-    when every view looks along one line (one view, or views within 15 degrees of it): the
-    footage shows such a turn only as foreshortening, the same for either sign. A ball joint
-    is always one; a hinge is not when its axis at ``pose`` lies within 25 degrees of the
-    line of sight (it turns in the image plane). Empty when the views look different ways."""
-    sight = [v.pose.R[2] for v in pose.views]
-    if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
-        return []
-    frames = Kinematics(skeleton, pose).frames
-    blind = []
-    for name in skeleton.tracked_joint_names():
-        j = skeleton.index(name)
-        if (skeleton.kinds[j] != HINGE
-                or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON):
-            blind.append(name)
-    return blind
-
-
-def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
-    """``skeleton`` with every joint ``depth_blind_joints`` names at ``pose`` a hinge about
-    the line of sight there (its axis in the joint's frame, its angle free): the paper's body
-    for one camera. ``skeleton`` itself when the views look different ways."""
-    blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose)]
-    if not blind:
-        return skeleton
-    frames = Kinematics(skeleton, pose).frames
-    kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
-    for j in blind:
-        kinds[j] = HINGE
-        axes[j] = frames[j, :3, :3].T @ pose.views[0].pose.R[2]
-        limits[j] = (-np.inf, np.inf)
-    out = Skeleton(skeleton.names, skeleton.parents, skeleton.offsets, kinds, axes,
-                   skeleton.end_sites, limits=limits)
-    out.blobs = skeleton.blobs
-    return out
 
 
 @dataclass(kw_only=True)
@@ -262,9 +223,8 @@ class Tracker:
         self.scales = Scales.unscaled(self.seq.n_views, self.settings)
         # the key frame's points by (frame, view, level), kept while the key frame is
         self.key_sets: dict[tuple[int, int, int], PointSet] = {}
-        self._backdrops: list[sil.Backdrop | None] | None = None  # None: not still
+        self._cue = sil.SilhouetteCue(self.seq)  # the backdrops, once the key frame is known
         self.notes: list[str] = []  # what the user should know about the run
-        self._fg_cache: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
         self._use(skeleton)
 
     def _use(self, skeleton: Skeleton) -> None:
@@ -291,10 +251,10 @@ class Tracker:
         s = self.settings
         if s.silhouette <= 0:
             return None
-        self._learn_first_backdrops(key, key_frame)
+        self._start_cue(key, key_frame)
         out = []
         for c in range(self.seq.n_views):
-            if self._backdrops[c] is None:
+            if not self._cue.has(c):
                 out.append(None)
                 continue
             lv = self.scales.view_level(c, level)
@@ -307,38 +267,21 @@ class Tracker:
             x0, y0 = np.maximum(np.floor((boxes[:, :2].min(0) - margin) / g), 0).astype(int)
             x1 = int(min(np.ceil((boxes[:, 2].max() + margin) / g), -(-shape[1] // g)))
             y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
-            fg = sil.at_level(self._foreground(c, frame), lv)[::g, ::g]
+            fg = sil.at_level(self._cue.foreground(c, frame), lv)[::g, ::g]
             crop = fg[y0:max(y1, y0), x0:max(x1, x0)]
             out.append((crop, (x0, y0), sil.NearestPixel(crop)))
         return out
 
-    def _learn_first_backdrops(self, key: BodyPose, key_frame: int) -> None:
-        """Each view's backdrop from the key frame, the first time one is needed (None for a
+    def _start_cue(self, key: BodyPose, key_frame: int) -> None:
+        """Each view's backdrop from the key frame, the first time one is needed (none for a
         view whose backdrop moves, with a note saying so)."""
-        if self._backdrops is not None:
+        if self._cue.started:
             return
         kin_key = Kinematics(self.skeleton, key)
-        self._backdrops = []
-        others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
-        for c in range(self.seq.n_views):
-            grey = self.seq.grey(c, key_frame)
-            backdrop = sil.Backdrop(grey, self._body_mask(key, kin_key, c, grey.shape), (
-                self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})),
-                sil.BODY_MARGIN * self.scales.magnification(c))
-            if not backdrop.still:
-                self.notes.append(f"view {c + 1}: the footage around the body changes from "
-                                  "frame to frame far more than a body's outline (a moving "
-                                  "camera or light, or a first pose that does not cover the "
-                                  "body), so its silhouette is not used")
-            self._backdrops.append(backdrop if backdrop.still else None)
-
-    def _foreground(self, view: int, frame: int) -> np.ndarray:
-        """Full-resolution 0/1 foreground of ``frame`` in ``view`` (the backdrop is known)."""
-        if (view, frame) not in self._fg_cache:
-            self._fg_cache = {k: v for k, v in self._fg_cache.items() if k[1] == frame}
-            self._fg_cache[view, frame] = self._backdrops[view].foreground(
-                self.seq.grey(view, frame))
-        return self._fg_cache[view, frame]
+        bodies = [self._body_mask(key, kin_key, c, self.seq.grey(c, key_frame).shape)
+                  for c in range(self.seq.n_views)]
+        self.notes += self._cue.start(key_frame, bodies, [
+            sil.BODY_MARGIN * self.scales.magnification(c) for c in range(self.seq.n_views)])
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
                       ) -> tuple[BodyPose, list[str]]:
@@ -346,10 +289,10 @@ class Tracker:
         on the level below full resolution, and the joints that turned."""
         if self.settings.silhouette <= 0:
             return est, []
-        self._learn_first_backdrops(key, key_frame)
+        self._start_cue(key, key_frame)
         lvs = self.scales.view_levels(self.scales.search_level())
-        fgs = [None if b is None else sil.at_level(self._foreground(c, frame), lv)
-               for c, (b, lv) in enumerate(zip(self._backdrops, lvs))]
+        fgs = [sil.at_level(self._cue.foreground(c, frame), lv) if self._cue.has(c) else None
+               for c, lv in enumerate(lvs)]
         if all(f is None for f in fgs):
             return est, []
         return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
@@ -399,7 +342,7 @@ class Tracker:
             self.scales = scales
             self.seq.set_levels(scales.pyramid_levels())
             self.key_sets.clear()
-            self._backdrops, self._fg_cache = None, {}
+            self._cue.reset()
 
     def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
@@ -412,13 +355,13 @@ class Tracker:
     def _learn_backdrops(self, res: FrameResult) -> None:
         """Let each view's backdrop see behind where the body was on an earlier frame, now
         that the tracked pose says where it is not."""
-        if not self._backdrops:
+        views = [c for c in range(self.seq.n_views) if self._cue.unseen(c)]
+        if not views:
             return
         kin = Kinematics(self.skeleton, res.pose)
-        for c, backdrop in enumerate(self._backdrops):
-            if backdrop is not None and backdrop.unseen.any():
-                grey = self.seq.grey(c, res.frame)
-                backdrop.learn(grey, self._body_mask(res.pose, kin, c, grey.shape))
+        for c in views:
+            shape = self.seq.grey(c, res.frame).shape
+            self._cue.learn(c, res.frame, self._body_mask(res.pose, kin, c, shape))
 
     def _active(self, pose: BodyPose, level: int) -> np.ndarray:
         """Unknowns solved on tracker level ``level``: the root always; a joint only where its
@@ -806,7 +749,8 @@ class Tracker:
         self._check_start(initial, frames[0])
         key_frame, key = frames[0], initial
         self.key_sets.clear()  # the key pose may differ from an earlier run's
-        self._backdrops, self._fg_cache, self.notes = None, {}, []  # learned from it
+        self._cue.reset()  # learned from it
+        self.notes = []
         blind = depth_blind_joints(self.given_skeleton, initial)
         if self.settings.side_on:
             self._use(side_on_skeleton(self.given_skeleton, initial))

@@ -9,15 +9,9 @@ from core.errors import InputError
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
+from core.side_on import depth_blind_joints, side_on_skeleton
 from core.skeleton import HINGE, human_template
-from core.tracker import (
-    PointSet,
-    Tracker,
-    TrackerSettings,
-    depth_blind_joints,
-    side_on_skeleton,
-    track,
-)
+from core.tracker import PointSet, Tracker, TrackerSettings, track
 from support.synthetic import render, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]

@@ -1,0 +1,54 @@
+"""Side-on: where every view looks along one line, the joints that would turn the limbs
+toward or away from the cameras become hinges about that line, as the paper tracks a body
+seen by one camera. The footage shows such a turn only as foreshortening, the same for
+either sign; as hinges in the image plane, the limbs follow what the footage shows and
+what it does not is held. Views that look different ways leave the body as it is."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .linearize import Kinematics
+from .pose import BodyPose
+from .search import SIDE_ON
+from .skeleton import HINGE, Skeleton
+
+ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
+
+
+def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
+    """Names of the tracked joints that turn their limbs toward or away from the cameras
+    when every view looks along one line (one view, or views within 15 degrees of it): the
+    footage shows such a turn only as foreshortening, the same for either sign. A ball joint
+    is always one; a hinge is not when its axis at ``pose`` lies within 25 degrees of the
+    line of sight (it turns in the image plane). Empty when the views look different ways."""
+    sight = [v.pose.R[2] for v in pose.views]
+    if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
+        return []
+    frames = Kinematics(skeleton, pose).frames
+    blind = []
+    for name in skeleton.tracked_joint_names():
+        j = skeleton.index(name)
+        if (skeleton.kinds[j] != HINGE
+                or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON):
+            blind.append(name)
+    return blind
+
+
+def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
+    """``skeleton`` with every joint ``depth_blind_joints`` names at ``pose`` a hinge about
+    the line of sight there (its axis in the joint's frame, its angle free): the paper's body
+    for one camera. ``skeleton`` itself when the views look different ways."""
+    blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose)]
+    if not blind:
+        return skeleton
+    frames = Kinematics(skeleton, pose).frames
+    kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
+    for j in blind:
+        kinds[j] = HINGE
+        axes[j] = frames[j, :3, :3].T @ pose.views[0].pose.R[2]
+        limits[j] = (-np.inf, np.inf)
+    out = Skeleton(skeleton.names, skeleton.parents, skeleton.offsets, kinds, axes,
+                   skeleton.end_sites, limits=limits)
+    out.blobs = skeleton.blobs
+    return out
