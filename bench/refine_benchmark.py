@@ -47,8 +47,9 @@ from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
 from core.pose import BodyPose  # noqa: E402
 from core.refine import carried_pose, joint_from_track, moved_joint, refine  # noqa: E402
+from core.settings import TrackerSettings  # noqa: E402
 from core.skeleton import Skeleton  # noqa: E402
-from core.tracker import Tracker, TrackerSettings, track  # noqa: E402
+from core.tracker import Tracker, track  # noqa: E402
 
 LEGS = ["left thigh", "right thigh", "left shank", "right shank"]
 

@@ -22,8 +22,8 @@ from .camera import View
 from .errors import InputError
 from .image import ImageError
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, pose_from_bvh
+from .settings import TrackerSettings
 from .skeleton import BALL, FIXED, HINGE, Skeleton, skeleton_from_bvh
-from .tracker import TrackerSettings
 from .video import VideoFrames, is_video
 
 

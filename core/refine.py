@@ -34,9 +34,10 @@ from .blas import one_blas_thread
 from .errors import InputError
 from .linearize import Kinematics, rows
 from .pose import CALIBRATED, BodyPose
+from .settings import TrackerSettings
 from .skeleton import BALL, HINGE, Skeleton
 from .solver import NormalEquations, solve
-from .tracker import Tracker, TrackerSettings, track
+from .tracker import Tracker, track
 
 REFINE_ITERATIONS = 4  # Gauss-Newton iterations a level, at least, on the tracks it reads
 SETTLED_SHIFT = 1e-3  # world units: a round that moves no joint more is settled ...

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .frame_fit import FrameResult
 from .job import Job
 from .pose import world_pose
-from .tracker import FrameResult, Tracker, TrackResult, frames_tracked, track
+from .tracker import Tracker, TrackResult, frames_tracked, track
 
 
 def run_job(

@@ -9,7 +9,7 @@ import textwrap
 
 import bpy
 
-from ..core.tracker import TrackerSettings
+from ..core.settings import TrackerSettings
 
 _MAIN_SETTINGS = ("side_on", "levels", "iterations", "key_weight")  # side-on: one view
 NOTE_WIDTH = 40  # characters a line of the Results panel's notes (the sidebar's own width)

@@ -1,6 +1,6 @@
 """What the scene keeps for tracking: the armature, the views, the direction, the settings.
 
-The tracker settings mirror ``core.tracker.TrackerSettings`` field by field, with its
+The tracker settings mirror ``core.settings.TrackerSettings`` field by field, with its
 documentation as tooltips, so that a new setting in core appears here without a second list.
 """
 
@@ -11,7 +11,7 @@ import dataclasses
 import bpy
 
 from ..core.pose import CALIBRATED, INDEPENDENT
-from ..core.tracker import TrackerSettings
+from ..core.settings import TrackerSettings
 
 _LIMITS = {  # soft ranges for the sliders; core validates the hard ones
     "levels": (1, 6), "iterations": (1, 50), "pixel_step": (1, 8), "max_step": (0.5, 90.0),
@@ -33,7 +33,7 @@ TWIST_PG_tracker_settings = type(
     "TWIST_PG_tracker_settings",
     (bpy.types.PropertyGroup,),
     {"__annotations__": {f.name: _property(f) for f in dataclasses.fields(TrackerSettings)},
-     "__doc__": "Tracker settings (see core.tracker.TrackerSettings)"},
+     "__doc__": "Tracker settings (see core.settings.TrackerSettings)"},
 )
 
 

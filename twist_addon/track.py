@@ -12,8 +12,9 @@ from dataclasses import dataclass, field
 import bpy
 
 from ..core.confidence import frame_list
+from ..core.frame_fit import FrameResult
 from ..core.pose import BodyPose, world_pose
-from ..core.tracker import FrameResult, Tracker, frames_tracked
+from ..core.tracker import Tracker, frames_tracked
 from . import checks, keyframes
 from .armature_action import ArmatureAction
 from .bridge import (

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from core.tracker import TrackerSettings
+from core.settings import TrackerSettings
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -72,14 +72,14 @@ def test_scene_settings_mirror_the_core_tracker_settings(installed):
         import dataclasses, importlib
         pkg = "bl_ext.user_default.twist_mocap"
         props = importlib.import_module(pkg + ".twist_addon.properties")
-        tracker = importlib.import_module(pkg + ".core.tracker")
+        settings = importlib.import_module(pkg + ".core.settings")
         scene = bpy.context.scene
         pg = scene.twist.tracker
         rna = pg.bl_rna.properties
         out["defaults"] = {f.name: getattr(pg, f.name)
-                           for f in dataclasses.fields(tracker.TrackerSettings)}
+                           for f in dataclasses.fields(settings.TrackerSettings)}
         out["tooltips"] = {f.name: rna[f.name].description
-                           for f in dataclasses.fields(tracker.TrackerSettings)}
+                           for f in dataclasses.fields(settings.TrackerSettings)}
         pg.levels, pg.key_weight, pg.stop_on_divergence = 2, 0.25, False
         s = props.settings_from_properties(pg)
         out["changed"] = [s.levels, s.key_weight, s.stop_on_divergence]

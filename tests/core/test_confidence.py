@@ -9,8 +9,9 @@ import pytest
 from core.confidence import MIN_LIMB_POINTS, UNSEEN, UNSURE, UNSURE_FLAG, Limbs, frame_list
 from core.pose import CALIBRATED, BodyPose
 from core.raycast import BlobStack
+from core.settings import TrackerSettings
 from core.skeleton import human_template
-from core.tracker import Tracker, TrackerSettings, track
+from core.tracker import Tracker, track
 from support.synthetic import render, side_view
 
 

@@ -121,8 +121,9 @@ def test_an_output_folder_that_does_not_exist_stops_the_run_before_it_starts(foo
 def test_the_report_is_strict_json_with_limb_checks_and_its_bvh_ends_before_a_divergence(
         footage, tmp_path):
     from core.confidence import LimbCheck
+    from core.frame_fit import FrameResult
     from core.run import report, result_bvh, write_report
-    from core.tracker import FrameResult, TrackResult
+    from core.tracker import TrackResult
 
     folder, _ = footage
     job = load_job(folder / "job.json")

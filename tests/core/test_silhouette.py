@@ -6,9 +6,10 @@ import numpy as np
 
 from core import se3
 from core.pose import INDEPENDENT, BodyPose, apply_update
+from core.settings import TrackerSettings
 from core.silhouette import Backdrop, NearestPixel, at_level, mismatch
 from core.skeleton import planar_chain_template
-from core.tracker import Tracker, TrackerSettings, track
+from core.tracker import Tracker, track
 from support.synthetic import render, side_view
 
 

@@ -6,12 +6,14 @@ import pytest
 from core import se3
 from core.camera import View
 from core.errors import InputError
+from core.frame_fit import PointSet
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
+from core.settings import TrackerSettings
 from core.side_on import depth_blind_joints, side_on_skeleton
 from core.skeleton import HINGE, human_template
-from core.tracker import PointSet, Tracker, TrackerSettings, track
+from core.tracker import Tracker, track
 from support.synthetic import render, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]

@@ -1,0 +1,598 @@
+"""One frame's fit: Gauss-Newton coarse to fine against the new frame's images.
+
+The pose predicted for a new frame is refined on an image pyramid from the coarsest level
+to the finest. Each iteration maps the body's pixels of two earlier frames -- the previous
+frame and the key frame (the first, user-posed one, or the last the user corrected; it
+holds the track against drift) -- to the new frame under the current estimate, samples the
+new image there, and solves one linear system for all views (paper section 2.5), as a
+Levenberg-Marquardt step that is kept only if it lowers the robust cost on the pixels
+visible before and after it, and shortened so that no joint turns more than a few degrees
+at once. A joint is solved only on levels where its blob is thick enough to see. Pixels
+whose front-most blob in the new frame is not the blob they came from are left out (a leg
+passing behind the other); pixel weights are the blob's rim weight times the EM support
+posterior. With still cameras, the blobs' outline is also held against the body's
+silhouette (``silhouette``): chamfer pulls in both directions whose reach is a limb's
+length, not a blob's width, so that a fast limb is caught and a lost one found again; and
+before refining, each limb is searched over a grid of turns against the silhouette
+(``core.search``), a turn kept where every view's pixels bear it out. The finished frame's
+limbs are checked against every view (``core.confidence``). Sizes in pixels are meant for a
+body about ``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that
+view's pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads
+every view where the body is about as large (``auto_scale``, ``core.scales``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import image as imagelib
+from . import raycast
+from . import silhouette as sil
+from .confidence import MIN_LIMB_POINTS, LimbCheck, Limbs
+from .errors import InputError
+from .linearize import Kinematics, rows
+from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, n_root_params
+from .scales import Scales
+from .search import LimbSearch
+from .sequence import ImageSequence
+from .settings import TrackerSettings
+from .skeleton import HINGE, Skeleton
+from .solver import (
+    NormalEquations,
+    mixture_cost,
+    robust_scale,
+    solve,
+    support_posterior,
+    support_weights,
+)
+
+SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
+
+
+@dataclass(kw_only=True)
+class FrameResult:
+    """One tracked frame: its pose and the facts the UI, the report and the benchmark read."""
+
+    frame: int
+    pose: BodyPose
+    residual: float  # support-weighted RMS brightness error on the finest level, image units
+    iterations: int
+    converged: bool
+    diverged: bool = False
+    reason: str = ""
+    seconds: float = 0.0
+    given: bool = False  # the user's pose (the initial one or a correction), not tracked
+    limbs: dict[str, LimbCheck] = field(default_factory=dict)  # tracked frames: each limb's
+
+    @property
+    def flagged(self) -> dict[str, str]:
+        """The limbs to check on this frame and why (``LimbCheck.flag``)."""
+        return {name: c.flag for name, c in self.limbs.items() if c.flag}
+
+
+
+@dataclass
+class PointSet:
+    """Body pixels of earlier frames in one view, ready to be mapped to the new frame: one
+    frame's, or several frames' one after the other (``lengths``: how many each; each has
+    its own noise scale)."""
+
+    view: int
+    seg_joint: np.ndarray  # (N,) joint whose segment holds the point
+    blob: np.ndarray  # (N,) blob index, for the visibility test
+    ref: np.ndarray  # (N, 3) reference-frame point
+    value: np.ndarray  # (N,) intensity in that frame
+    weight: np.ndarray  # (N,) rim weight times the set's weight
+    lengths: tuple[int, ...] = ()  # points per frame, when several frames are joined
+
+    @staticmethod
+    def joined(sets: list[PointSet]) -> PointSet:
+        """One set of the points of ``sets`` (all of one view), in order."""
+        if len(sets) == 1:
+            return sets[0]
+        return PointSet(sets[0].view, *(np.concatenate([getattr(ps, f) for ps in sets])
+                                        for f in ("seg_joint", "blob", "ref", "value",
+                                                  "weight")),
+                        tuple(len(ps.value) for ps in sets))
+
+
+@dataclass
+class _Samples:
+    """One pose's look at the point sets on one level."""
+
+    costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
+    parts: list  # per set: (indices of usable points, their q, image gradients, residuals)
+    inside: np.ndarray  # (views,) fraction of each view's points inside its image
+    sigmas: list  # per set, its points' noise scales (N,)
+    shape_cost: float = 0.0  # the silhouette term's cost
+    shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
+
+
+
+class FrameFit:
+    """Fits a body (a skeleton with blobs) to one new frame at a time in the footage of one
+    or more views, holding what the frames share: the key frame's pixels, the silhouette's
+    backdrops, the pyramids' scale for the body's size."""
+
+    def __init__(
+        self,
+        skeleton: Skeleton,
+        images: Sequence[Sequence],
+        mode: str = INDEPENDENT,
+        settings: TrackerSettings | None = None,
+    ):
+        if mode not in (CALIBRATED, INDEPENDENT):
+            raise InputError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
+        if not skeleton.blobs:
+            raise InputError("the skeleton has no blobs: give its segments ellipsoids")
+        self.mode = mode
+        self.settings = settings or TrackerSettings()
+        self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
+        # each view's pixel sizes for the body's size there (``scale_to``), as seq is built
+        self.scales = Scales.unscaled(self.seq.n_views, self.settings)
+        # the key frame's points by (frame, view, level), kept while the key frame is
+        self.key_sets: dict[tuple[int, int, int], PointSet] = {}
+        self._cue = sil.SilhouetteCue(self.seq)  # the backdrops, once the key frame is known
+        self.notes: list[str] = []  # what the user should know about the run
+        self._use(skeleton)
+
+    def _use(self, skeleton: Skeleton) -> None:
+        """Track ``skeleton``: its degrees of freedom and what depends on them."""
+        self.skeleton = skeleton
+        self._dof_joint, self._dof_axis = skeleton.dof_joints_and_axes()
+        self.n_dof = len(self._dof_joint)
+        self.n_params = n_root_params(self.mode, self.seq.n_views) + self.n_dof
+        self._blobs = raycast.BlobStack.of(skeleton.blobs)  # as they are now, stacked
+        # thinnest blob each degree of freedom turns directly, world units (inf: none)
+        thin = np.full(skeleton.n_joints, np.inf)
+        np.minimum.at(thin, self._blobs.joint, self._blobs.radii[:, 1:].min(axis=1))
+        self.dof_thickness = thin[self._dof_joint]
+        self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
+                         and np.any(np.isfinite(skeleton.limits[j]))]
+        self._search = LimbSearch(skeleton, self.settings.limb_search)
+        self._limbs = Limbs(skeleton, self._blobs)
+
+    def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
+                     est: BodyPose, kin: Kinematics) -> list | None:
+        """Per view, the foreground of ``frame`` around the body at ``est`` on the view's
+        level for tracker level ``level`` (None when the term is off): (boolean crop, its
+        top-left level pixel, its ``NearestPixel``)."""
+        s = self.settings
+        if s.silhouette <= 0:
+            return None
+        self._start_cue(key, key_frame)
+        out = []
+        for c in range(self.seq.n_views):
+            if not self._cue.has(c):
+                out.append(None)
+                continue
+            lv = self.scales.view_level(c, level)
+            g = self.scales.grid(c, lv)
+            margin = self.scales.cap(c) / 2**lv + 2 * g
+            shape = self.seq.pyramid(c, frame)[lv].shape
+            boxes = raycast.blob_boxes(est.views[c].at_level(lv), self._blobs,
+                                       kin.segments)
+            # on the label map's grid (every g-th level pixel)
+            x0, y0 = np.maximum(np.floor((boxes[:, :2].min(0) - margin) / g), 0).astype(int)
+            x1 = int(min(np.ceil((boxes[:, 2].max() + margin) / g), -(-shape[1] // g)))
+            y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
+            fg = sil.at_level(self._cue.foreground(c, frame), lv)[::g, ::g]
+            crop = fg[y0:max(y1, y0), x0:max(x1, x0)]
+            out.append((crop, (x0, y0), sil.NearestPixel(crop)))
+        return out
+
+    def _start_cue(self, key: BodyPose, key_frame: int) -> None:
+        """Each view's backdrop from the key frame, the first time one is needed (none for a
+        view whose backdrop moves, with a note saying so)."""
+        if self._cue.started:
+            return
+        kin_key = Kinematics(self.skeleton, key)
+        bodies = [self._body_mask(key, kin_key, c, self.seq.grey(c, key_frame).shape)
+                  for c in range(self.seq.n_views)]
+        self.notes += self._cue.start(key_frame, bodies, [
+            sil.BODY_MARGIN * self.scales.magnification(c) for c in range(self.seq.n_views)])
+
+    def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
+                      ) -> tuple[BodyPose, list[str]]:
+        """``est`` with every limb turned to where the silhouette wants it (``LimbSearch``),
+        on the level below full resolution, and the joints that turned."""
+        if self.settings.silhouette <= 0:
+            return est, []
+        self._start_cue(key, key_frame)
+        lvs = self.scales.view_levels(self.scales.search_level())
+        fgs = [sil.at_level(self._cue.foreground(c, frame), lv) if self._cue.has(c) else None
+               for c, lv in enumerate(lvs)]
+        if all(f is None for f in fgs):
+            return est, []
+        return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
+
+    def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
+                   sets: list[PointSet], levels: list, level: int) -> BodyPose:
+        """``est`` with the turns of ``searched`` that the pixels bear out: a limb's turn is
+        kept only when, in every view that sees the limb, its pixels of the earlier frames
+        match the new image clearly better turned than not (the mean of their costs'
+        differences over twice its standard error); else the limb keeps its predicted
+        motion. The silhouette proposes, brightness decides: an outline alone also fits
+        shadows, clutter and the gaps between other limbs. A limb no view's earlier pixels
+        show (it was hidden) has only its outline to go by, and the search's own test
+        stands."""
+        kin = Kinematics(self.skeleton, est)
+        base = self.sample(est, kin, sets, levels, level)
+        moved = self.skeleton.moved_by()
+        bounds = np.cumsum([0] + [len(ps.value) for ps in sets])
+        out = est
+        for limb in self._search.limbs:
+            if self.skeleton.names[limb.joint] not in turned:
+                continue
+            cand = out.copy()
+            for j, _, _ in limb.dofs:
+                cand.rotations[j] = searched.rotations[j]
+            trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
+                                base.sigmas)
+            seen = clear = 0
+            for c, ps in enumerate(sets):
+                on = moved[ps.seg_joint, limb.joint]
+                old, new = (x[bounds[c]:bounds[c + 1]][on] for x in (base.costs, trial.costs))
+                both = ~np.isnan(old) & ~np.isnan(new)
+                if both.sum() < MIN_LIMB_POINTS:
+                    continue  # this view does not see the limb (hidden, or too small)
+                seen += 1
+                d = old[both] - new[both]
+                clear += d.mean() > 2 * d.std() / np.sqrt(len(d))
+            if clear == seen:  # no view's pixels see it (hidden before): the outline decides
+                out = cand
+        return out
+
+    def scale_to(self, pose: BodyPose) -> None:
+        """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
+        what was built for another size is dropped."""
+        scales = Scales.of(self.skeleton, pose, self.settings)
+        if scales != self.scales:
+            self.scales = scales
+            self.seq.set_levels(scales.pyramid_levels())
+            self.key_sets.clear()
+            self._cue.reset()
+
+    def _body_mask(self, pose: BodyPose, kin: Kinematics, view: int, shape) -> np.ndarray:
+        """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
+        (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
+        an error the backdrop's margin (as many times wider) covers."""
+        g = self.scales.magnification(view)
+        covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
+        return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
+
+    def _learn_backdrops(self, res: FrameResult) -> None:
+        """Let each view's backdrop see behind where the body was on an earlier frame, now
+        that the tracked pose says where it is not."""
+        views = [c for c in range(self.seq.n_views) if self._cue.unseen(c)]
+        if not views:
+            return
+        kin = Kinematics(self.skeleton, res.pose)
+        for c in views:
+            shape = self.seq.grey(c, res.frame).shape
+            self._cue.learn(c, res.frame, self._body_mask(res.pose, kin, c, shape))
+
+    def _active(self, pose: BodyPose, level: int) -> np.ndarray:
+        """Unknowns solved on tracker level ``level``: the root always; a joint only where its
+        blob is at least ``min_blob_pixels`` thick in the largest view's level, so that
+        coarse levels do not fling thin limbs they cannot see."""
+        scale = max(v.pose.s for v in pose.views) / 2**level
+        nr = self.n_params - self.n_dof
+        return np.concatenate([np.ones(nr, bool),
+                               self.dof_thickness * scale >= self.settings.min_blob_pixels])
+
+    # --- point sets ---------------------------------------------------------------------
+    def point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
+                  set_weight: float) -> PointSet:
+        level = self.seq.pyramid(view, frame)[lv]
+        step = self.scales.grid(view, lv)
+        v_l = pose.views[view].at_level(lv)
+        pix_l, hits, _ = raycast.render_labels(
+            v_l, self._blobs, kin.segments, level.shape, step
+        )
+        ok = hits.label >= 0
+        pix_l, label = pix_l[ok].astype(int), hits.label[ok]
+        seg_joint = self._blobs.joint[label]
+        g = kin.segments[seg_joint]
+        d = hits.world[ok] - g[:, :3, 3]
+        ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
+        value = level.stack[pix_l[:, 1], pix_l[:, 0], 0].astype(float)
+        rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
+        return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
+
+    def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int,
+                   grid: int):
+        """Front-most blob (-1: none) at every ``grid``-th level pixel, as a map whose pixel
+        (i, j) is level pixel (grid i, grid j), and per map pixel the index of its hit."""
+        v_l = pose.views[view].at_level(lv)
+        pix, hits, box = raycast.render_labels(v_l, self._blobs, kin.segments, shape,
+                                               grid)
+        size = (-(-shape[0] // grid), -(-shape[1] // grid))
+        lab = np.full(size, -1, dtype=np.int32)
+        idx = np.full(size, -1, dtype=np.int32)
+        if box is not None:
+            at = (pix[:, 1].astype(int) // grid, pix[:, 0].astype(int) // grid)
+            lab[at] = hits.label
+            idx[at] = np.arange(len(pix))
+        return lab, idx, hits
+
+    # --- one level -----------------------------------------------------------------------
+    def sample(self, est: BodyPose, kin: Kinematics, sets: list[PointSet], levels: list,
+               level: int, sigmas: list[np.ndarray] | None = None, fgs: list | None = None
+               ) -> _Samples:
+        """Map every point set into the new frame under ``est``: per-point robust costs (NaN
+        where the point is hidden by another blob or off the image) and what the rows need.
+        ``levels`` holds each view's pyramid level for tracker level ``level``. Without
+        ``sigmas`` the points' noise scales are measured here (``_sigmas``): a level's
+        starting pose sets them, and its candidates are costed with them."""
+        s = self.settings
+        costs, parts = [], []
+        n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
+        lvs = self.scales.view_levels(level)
+        gs = [self.scales.grid(c, lv) for c, lv in enumerate(lvs)]
+        maps = [self._label_map(est, kin, c, levels[c].shape, lvs[c], gs[c])
+                for c in range(self.seq.n_views)]
+        labels = [m[0] for m in maps]
+        shape_cost, shape_parts = 0.0, []
+        if fgs is not None:
+            for c, ((lab, idx, hits), view_fg) in enumerate(zip(maps, fgs)):
+                if view_fg is None:
+                    shape_parts.append(((), (), (), ()))
+                    continue
+                fg, (x0, y0), nearest_fg = view_fg
+                crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
+                full = 2**lvs[c] * gs[c]  # full-resolution pixels per map pixel
+                mm = sil.mismatch(lab[crop], fg, self.scales.cap(c) / full,
+                                  nearest_fg=nearest_fg)
+                shape_cost += s.silhouette * mm.cost
+                mm.model += (x0, y0)
+                mm.target += (x0, y0)
+                h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
+                shape_parts.append((self._blobs.joint[hits.label[h]], hits.world[h],
+                                    mm.target * full, mm.weight))
+        measured = []
+        for k, ps in enumerate(sets):
+            view = est.views[ps.view]
+            q = view.scaled(kin.world_points(ps.seg_joint, ps.ref))
+            pix = q[:, :2] + view.center
+            vals, inside = imagelib.sample(levels[ps.view], pix)
+            if sigmas is None:
+                measured.append(self._sigmas(ps, vals[:, 0] - ps.value, inside))
+            sigma = measured[-1] if sigmas is None else sigmas[k]
+            p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / gs[ps.view]).astype(int)
+            lab = labels[ps.view]
+            H, W = lab.shape
+            inb = (p_l[:, 0] >= 0) & (p_l[:, 0] < W) & (p_l[:, 1] >= 0) & (p_l[:, 1] < H)
+            visible = np.zeros(len(pix), dtype=bool)
+            visible[inb] = lab[p_l[inb, 1], p_l[inb, 0]] == ps.blob[inb]
+            ok = np.flatnonzero(inside & visible)
+            n_pts[ps.view] += len(pix)
+            n_inside[ps.view] += int(inside.sum())
+            r = vals[ok, 0] - ps.value[ok]
+            c = np.full(len(pix), np.nan)
+            c[ok] = ps.weight[ok] * mixture_cost(r, sigma[ok], s.outlier_density)
+            costs.append(c)
+            parts.append((ok, q[ok], vals[ok, 1:3], r))
+        return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
+                        measured if sigmas is None else sigmas, shape_cost, shape_parts)
+
+    def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
+                       ) -> np.ndarray:
+        """Weights of a point set's usable points ``ok`` with residuals ``r`` (the set's
+        points' noise scales ``sigma``): their rim weight times the EM support posterior."""
+        return ps.weight[ok] * support_weights(r, sigma[ok], self.settings.outlier_density)
+
+    def _normal_equations(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
+                          sigmas: list[np.ndarray], level: int) -> NormalEquations:
+        """Rows of every point set at the sampled pose, weighted by the EM support posterior,
+        and the silhouette's rows (each mismatched pixel's two coordinates); one block of
+        rows per view."""
+        pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, q, grad, r, w)
+        for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
+            if len(ok):
+                pieces[ps.view].append((ps.seg_joint[ok], q, grad, r,
+                                        self._pixel_weights(ps, ok, r, sigma)))
+        s = self.settings
+        for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
+            if not len(joints):
+                continue
+            lv = self.scales.view_level(c, level)
+            g = 2**lv * self.scales.grid(c, lv)  # full-resolution pixels per map pixel
+            every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
+            joints, world, target = joints[::every], world[::every], target[::every]
+            pair_w = pair_w[::every]
+            view = kin.pose.views[c]
+            q = view.scaled(world)
+            n = len(q)
+            unit = np.zeros((2 * n, 2))  # x rows, then y rows
+            unit[:n, 0] = unit[n:, 1] = 1.0
+            r = (q[:, :2] + view.center - target).T.ravel()
+            w = np.tile(pair_w, 2) * (s.silhouette * every / g**2)
+            pieces[c].append((np.tile(joints, 2), np.tile(q, (2, 1)), unit, r, w))
+        ne = NormalEquations.zeros(self.n_params)
+        for c, view_pieces in enumerate(pieces):
+            if view_pieces:
+                joints, q, grad, r, w = (np.concatenate(x) for x in zip(*view_pieces))
+                ne.add(rows(kin, c, self.mode, joints, q, grad), r, w)
+        return ne
+
+    def _sigmas(self, ps: PointSet, r: np.ndarray, inside: np.ndarray) -> np.ndarray:
+        """Residual scale of a point set's points (N,) from their residuals ``r`` (N,) and
+        which fell inside the image: one scale per frame the set joins."""
+        lengths = ps.lengths or (len(r),)
+        cuts = np.cumsum(lengths)[:-1]
+        scales = [robust_scale(part_r[part_in], self.settings.noise_floor)
+                  for part_r, part_in in zip(np.split(r, cuts), np.split(inside, cuts))]
+        return np.repeat(scales, lengths)
+
+    def _residual(self, sets: list[PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
+        """RMS brightness error of the pixels that follow the body (support-weighted), in
+        image units: what the report calls a frame's residual."""
+        num = den = 0.0
+        for ps, sigma, (ok, _, _, r) in zip(sets, sigmas, smp.parts):
+            w = self._pixel_weights(ps, ok, r, sigma)
+            num += float(np.sum(w * r * r))
+            den += float(np.sum(w))
+        return float(np.sqrt(num / den)) if den > 0 else float("nan")
+
+    def _limb_checks(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
+                     fgs: list | None) -> dict[str, LimbCheck]:
+        """Each limb's confidence at the finest level's pose ``kin`` (``core.confidence``):
+        per view, its mapped pixels' support (1 for a perfect match) and how much of its
+        bone lies on the silhouette."""
+        top = 1 + self.settings.outlier_density
+        axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
+        per_view = []
+        for c, (ps, sigma, (ok, _, _, r)) in enumerate(zip(sets, smp.sigmas, smp.parts)):
+            support = np.full(len(ps.value), np.nan)
+            support[ok] = np.minimum(
+                top * support_posterior(r, sigma[ok], self.settings.outlier_density), 1.0)
+            on = None
+            if fgs is not None and fgs[c] is not None:
+                crop, (x0, y0), _ = fgs[c]  # on every g-th pixel of the view's level
+                lv = self.scales.view_level(c, 0)
+                g = self.scales.grid(c, lv)
+                px = np.rint(kin.pose.views[c].at_level(lv).project(axis) / g).astype(int)
+                px -= (x0, y0)
+                inside = ((px >= 0) & (px < (crop.shape[1], crop.shape[0]))).all(axis=1)
+                on = np.full(len(px), np.nan)
+                on[inside] = crop[px[inside, 1], px[inside, 0]]
+            per_view.append(self._limbs.view_agreement(ps.blob, support, on))
+        return self._limbs.checks(per_view)
+
+    def _trust(self, delta: np.ndarray) -> np.ndarray:
+        """The step shortened so that no joint turns more than ``max_step`` degrees: far from
+        the linearisation point the rows no longer describe the motion, and a thin limb would
+        otherwise be flipped by one step."""
+        turn = np.max(np.abs(delta[self.n_params - self.n_dof:]), initial=0.0)
+        cap = np.radians(self.settings.max_step)
+        return delta * (cap / turn) if turn > cap else delta
+
+    def _within_limits(self, est: BodyPose, delta: np.ndarray) -> np.ndarray:
+        """The step with every limited hinge's new angle clipped into its range (a hinge
+        found outside it may only move back toward it)."""
+        nr = self.n_params - self.n_dof
+        for k in self._limited:
+            j = self._dof_joint[k]
+            delta[nr + k] = np.clip(delta[nr + k], *self.skeleton.hinge_turns(j, est.rotations[j]))
+        return delta
+
+    def _left_views(self, smp: _Samples) -> str:
+        """'' while enough of the body is inside every image, else which views it left."""
+        gone = np.flatnonzero(smp.inside < self.settings.min_inside)
+        if not len(gone):
+            return ""
+        return "the body left the image of view " + ", ".join(str(c + 1) for c in gone)
+
+    def _blob_pixels(self, kin: Kinematics) -> np.ndarray:
+        """Image positions (views, blobs, 2) of the blob centres, for the convergence test."""
+        centres = kin.world_points(self._blobs.joint, self._blobs.centre)
+        return np.array([v.project(centres) for v in kin.pose.views])
+
+    def frame_pixels(self, prev: BodyPose, prev_frame: int, est: BodyPose, frame: int
+                     ) -> list[tuple]:
+        """The body's pixels of ``prev_frame`` (at pose ``prev``, full resolution, every
+        ``pixel_step``-th) mapped into ``frame`` under ``est``, those visible there: per view
+        (view, segment joints (N,), scaled camera points q (N, 3), image gradients (N, 2),
+        brightness residuals (N,), EM support weights (N,)). For estimates made outside the
+        tracker's own system (the skeleton's refinement)."""
+        self.scale_to(prev)
+        kin_prev, kin = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, est)
+        levels = [self.seq.pyramid(c, frame)[0] for c in range(self.seq.n_views)]
+        sets = [self.point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
+                for c in range(self.seq.n_views)]
+        smp = self.sample(est, kin, sets, levels, 0)
+        out = []
+        for ps, sigma, (ok, q, grad, r) in zip(sets, smp.sigmas, smp.parts):
+            w = self._pixel_weights(ps, ok, r, sigma)
+            out.append((ps.view, ps.seg_joint[ok], q, grad, r, w))
+        return out
+
+    def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
+                    predicted: BodyPose, frame: int) -> FrameResult:
+        """One frame: refine ``predicted`` against the previous frame (``prev`` on
+        ``prev_frame``) and the key frame, coarse to fine. Raises DegenerateSystem."""
+        s = self.settings
+        t0 = time.perf_counter()
+        self.scale_to(key)
+        est = predicted
+        offset = np.zeros(self.n_params)
+        total_iters = 0
+        converged = False
+        kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
+        for level in reversed(range(self.scales.n_levels())):
+            lvs = self.scales.view_levels(level)
+            levels = [self.seq.pyramid(c, frame)[lv] for c, lv in enumerate(lvs)]
+            sets = []  # per view, the previous frame's points then the key frame's
+            for c, lv in enumerate(lvs):
+                view_sets = [self.point_set(prev, kin_prev, c, prev_frame, lv, 1.0)]
+                if s.key_weight > 0 and key_frame != prev_frame:
+                    k = (key_frame, c, lv)
+                    if k not in self.key_sets:
+                        self.key_sets[k] = self.point_set(key, kin_key, c, key_frame, lv,
+                                                          s.key_weight)
+                    view_sets.append(self.key_sets[k])
+                sets.append(PointSet.joined(view_sets))
+            kin = Kinematics(self.skeleton, est)
+            if s.limb_search > 0 and level == self.scales.search_level():
+                searched, turned = self._search_limbs(est, frame, key, key_frame)
+                if turned:
+                    searched = self._evidenced(est, searched, turned, sets, levels, level)
+                if searched is not est:  # the prediction from here on (what prior holds to)
+                    est, offset = searched, np.zeros(self.n_params)
+                    kin = Kinematics(self.skeleton, est)
+            active = self._active(est, level)
+            fgs = self._foregrounds(frame, level, key, key_frame, est, kin)
+            smp = self.sample(est, kin, sets, levels, level, None, fgs)
+            sigmas = smp.sigmas
+            left = self._left_views(smp)
+            if left:
+                return FrameResult(frame=frame, pose=est, residual=float("nan"),
+                                   iterations=total_iters, converged=False, diverged=True,
+                                   reason=left, seconds=time.perf_counter() - t0)
+            ne = self._normal_equations(kin, sets, smp, sigmas, level)
+            prior = s.prior * np.diag(ne.H)
+            lam = s.damping
+            converged = False
+            for it in range(s.iterations):
+                total_iters += 1
+                delta = self._within_limits(est, self._trust(solve(ne, lam, prior, offset,
+                                                                    active)))
+                cand = apply_update(self.skeleton, est, delta, self.mode)
+                kin_c = Kinematics(self.skeleton, cand)
+                c_smp = self.sample(cand, kin_c, sets, levels, level, sigmas, fgs)
+                # compare on the pixels seen in both poses: a step must not win by hiding pixels
+                both = ~np.isnan(smp.costs) & ~np.isnan(c_smp.costs)
+                old = float(np.sum(smp.costs[both]) + smp.shape_cost + prior @ offset**2)
+                new = float(np.sum(c_smp.costs[both]) + c_smp.shape_cost
+                            + prior @ (offset + delta) ** 2)
+                if new <= old:
+                    moved = np.max(np.linalg.norm(self._blob_pixels(kin_c)
+                                                  - self._blob_pixels(kin), axis=-1))
+                    est, kin, smp = cand, kin_c, c_smp
+                    offset = offset + delta
+                    lam = max(lam / 3, 1e-6)
+                    if moved / 2**level < s.converge_pixels:
+                        converged = True
+                        break
+                    if it + 1 < s.iterations:
+                        ne = self._normal_equations(kin, sets, smp, sigmas, level)
+                else:
+                    lam *= 4
+                    if lam > 1e4:
+                        converged = True  # no step lowers the cost: a minimum at this level
+                        break
+        result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
+                             iterations=total_iters, converged=converged,
+                             limbs=self._limb_checks(kin, sets, smp, fgs))
+        left = self._left_views(smp)
+        if left:
+            result.diverged, result.reason = True, left
+        result.seconds = time.perf_counter() - t0
+        return result
+
+    # --- the sequence ----------------------------------------------------------------------

@@ -1,0 +1,76 @@
+"""The tracker's settings: every knob with its default and what it does, settable from a
+job's ``settings`` and shown as the add-on's Track settings (their tooltips are the fields'
+``doc``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .errors import InputError
+from .scales import REFERENCE_BODY_PIXELS
+
+
+def _knob(default, doc: str):
+    return field(default=default, metadata={"doc": doc})
+
+
+@dataclass
+class TrackerSettings:
+    """Tracker knobs with their defaults; every field can be set from a job's ``settings``,
+    and each field's ``metadata["doc"]`` says what it does (the add-on's tooltips)."""
+
+    levels: int = _knob(3, "Pyramid levels, coarse to fine (1: full resolution only)")
+    highpass: float = _knob(4.0, "Shading removal: subtract the local mean over this many "
+                            "pixels of each level (0: off)")
+    iterations: int = _knob(3, "Gauss-Newton iterations per pyramid level, at most")
+    pixel_step: int = _knob(2, "Use every n-th pixel across and down on the finest level")
+    auto_scale: bool = _knob(True, "Fit the settings counted in pixels to the body's size in "
+                             "each view: where it stands over about 280 pixels tall, that "
+                             "view is tracked as if halved once per doubling over "
+                             f"{REFERENCE_BODY_PIXELS:g}, with its finer pixels sampled "
+                             "sparsely on added pyramid levels (faster, and steadier)")
+    key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
+                              "frame's: holds the track against drift")
+    damping: float = _knob(1e-2, "Initial Levenberg-Marquardt damping")
+    max_step: float = _knob(15.0, "Degrees any joint may turn in one iteration")
+    prior: float = _knob(0.0, "Pull toward the predicted pose, relative to what the pixels "
+                         "say about each unknown")
+    outlier_density: float = _knob(0.1, "Support maps: how likely a pixel is not to follow "
+                                   "its blob (background, occluders, highlights)")
+    noise_floor: float = _knob(0.01, "Smallest brightness noise assumed (0 to 1)")
+    rim_width: float = _knob(0.3, "Blob outline band whose pixels count less, as a share of "
+                             "the blob's radius")
+    prediction_gain: float = _knob(1.0, "Constant-velocity prediction of the next frame "
+                                   "(0: start from the last pose)")
+    converge_pixels: float = _knob(0.2, "Stop iterating a level when no blob moves more "
+                                   "pixels than this")
+    min_blob_pixels: float = _knob(1.5, "Solve a joint on levels where its blob is at least "
+                                   "this many pixels thick")
+    divergence_ratio: float = _knob(3.0, "Flag a frame whose residual exceeds the median so "
+                                    "far by this factor")
+    min_inside: float = _knob(0.5, "Flag a frame when less of the body than this stays "
+                              "inside a view's image")
+    stop_on_divergence: bool = _knob(True, "Stop at the first flagged frame")
+    silhouette: float = _knob(0.1, "Weight of the body's silhouette against the still "
+                              "backdrop (0: off): pulls limbs onto the outline from farther "
+                              "than brightness reaches. Needs cameras that stand still")
+    silhouette_cap: float = _knob(24.0, "Farthest a silhouette mismatch pulls, in pixels of "
+                                  "the full image")
+    side_on: bool = _knob(True, "Where every view looks along one line (one view): track "
+                          "every joint that could turn toward or away from the camera as a "
+                          "hinge about the line of sight at the first frame, as the paper "
+                          "does with one camera: the limbs follow the footage in the image, "
+                          "and what the footage does not show in depth is held, not guessed "
+                          "(off: those turns are read from foreshortening alone). Views that "
+                          "look different ways are not affected")
+    limb_search: float = _knob(0.1, "Before refining a frame, turn each limb over a grid of "
+                               "angles against the silhouette and keep the best turn when it "
+                               "beats the prediction by this share of the limb's outline, "
+                               "and by that again per 45 degrees of turn squared, and every "
+                               "view whose pixels see the limb bears the turn out (0: off). "
+                               "Catches limbs faster than a blob's width a frame")
+
+    def __post_init__(self):
+        for name in ("levels", "iterations", "pixel_step"):
+            if int(getattr(self, name)) < 1:
+                raise InputError(f"settings.{name} must be a whole number >= 1")
