@@ -66,20 +66,22 @@ def _check(sk: Skeleton, clicks: list[dict], n_unknowns: int) -> None:
 
 def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
              fit_lengths: bool = True) -> FitResult:
-    """Fit pose (and lengths) to ``clicks`` (per view: joint name -> (x, y) pixels)."""
+    """Fit pose (and lengths) to ``clicks`` (per view: point name -> (x, y) pixels; a point
+    is a joint, or ``"<joint>/end"``, the tip of that joint's first end site: a foot or a
+    hoof that ends a limb, whose length the fit keeps)."""
     if len(clicks) != len(guess.views):
         raise FitError(f"clicks for {len(clicks)} views, but {len(guess.views)} views")
     for c, view_clicks in enumerate(clicks):
         for name in view_clicks:
-            if name not in sk.names:
-                raise FitError(f"view {c + 1}: no joint named '{name}'")
+            _clicked_point(sk, name, f"view {c + 1}")
     dof_joint, dof_axis = sk.dof_joints_and_axes()
     joints = sorted(set(dof_joint.tolist()))
     # a bone on the way from the root to a clicked joint gets its own length (shared with
     # its mirror twin): even an unclicked trunk bone decides where the clicked shoulders can
     # be (one common factor for them left the upper arms 2 degrees off with exact clicks);
     # bones below every click scale with one common factor, so that they do not soak up noise
-    clicked = {sk.index(n) for v in clicks for n in v}
+    points = [[_clicked_point(sk, n, "") for n in v] for v in clicks]  # (joint, at its end)
+    clicked = {j for v in points for j, _ in v}  # a clicked end counts as its joint here
     on_path = {a for c in clicked for a in sk.ancestors(c)}  # clicked joints and above
 
     def chain_start(j: int) -> int:
@@ -103,7 +105,7 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     # what clicked joint positions can pin down: the root, and per joint with a clicked joint
     # below it its swing (a ball's twist about its bone moves no joint on the bone); lengths
     # lean on their prior and bounds
-    above_click = {a for c in clicked for a in sk.ancestors(c)[1:]}
+    above_click = {a for v in points for j, end in v for a in sk.ancestors(j)[0 if end else 1:]}
     swings = sum(2 if sk.kinds[j] == BALL else 1 for j in joints if j in above_click)
     _check(sk, clicks, n_root + swings)
     if fit_lengths and len(clicks) == 1:
@@ -118,14 +120,20 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
         return pose.rotations, pose.root_position, sk.offsets * scale[:, None], pose.views, \
             factors
 
-    # per view, the clicked joints and their clicks (n, 2)
-    clicked_at = [(np.array([sk.index(n) for n in v], dtype=int),
-                   np.array(list(v.values()), dtype=float).reshape(-1, 2)) for v in clicks]
+    # per view, the clicked points (joint, tip in its frame: zero for the joint itself) and
+    # their clicks (n, 2)
+    tip = [np.asarray(sk.end_sites[j][0], float) if sk.end_sites[j] else np.zeros(3)
+           for j in range(sk.n_joints)]
+    clicked_at = [(np.array([j for j, _ in v], dtype=int),
+                   np.array([tip[j] if end else np.zeros(3) for j, end in v]).reshape(-1, 3),
+                   np.array(list(c.values()), dtype=float).reshape(-1, 2))
+                  for v, c in zip(points, clicks)]
 
     def residuals(x):
         R, root, offsets, views, factors = unpack(x)
-        X = sk.world_positions(R, root, offsets)
-        res = [(v.project(X[idx]) - pts).ravel() for v, (idx, pts) in zip(views, clicked_at)]
+        M = sk.joint_frames(R, root, offsets)
+        res = [(v.project(np.einsum("nab,nb->na", M[idx, :3, :3], ref) + M[idx, :3, 3])
+                - pts).ravel() for v, (idx, ref, pts) in zip(views, clicked_at)]
         res += [PRIOR_ANGLE * x[n_root:n_root + n_dof], PRIOR_LENGTH * x[n_root + n_dof:]]
         return np.concatenate(res)
 
@@ -179,6 +187,19 @@ def least_certain(uncertainty: dict[str, float], n: int = 3, views: int = 2) -> 
                "foreshortening" if views == 1 else "click the joints below it in a view")
         parts.append(f"not pinned: {', '.join(free)} ({why})")
     return "; ".join(parts) or "none turned"
+
+
+def _clicked_point(sk: Skeleton, name: str, where: str) -> tuple[int, bool]:
+    """The joint a click names and whether it is at the joint's end site (``"Knee/end"``);
+    FitError for a name the skeleton lacks."""
+    joint, slash, end = name.partition("/")
+    if joint not in sk.names or (slash and end != "end"):
+        raise FitError(f"{where}: no joint named '{name}'" if where else name)
+    j = sk.index(joint)
+    if slash and not sk.end_sites[j]:
+        raise FitError(f"{where}: '{joint}' has no end site to click ('{name}'): click a "
+                       "joint, or the end of a bone that ends a limb")
+    return j, bool(slash)
 
 
 def _turned_bones(sk: Skeleton, joints: list[int]) -> list[tuple[int, int]]:

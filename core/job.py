@@ -347,8 +347,10 @@ def load_fit(path: str | Path) -> FitJob:
         if not isinstance(c, dict):
             raise JobError(f"{w}: expected an object of joint name -> [x, y]")
         for name in c:
-            if name not in sk.names:
-                raise JobError(f"{w}.{name}: no such joint in the BVH")
+            joint, slash, end = name.partition("/")
+            if joint not in sk.names or (slash and end != "end"):
+                raise JobError(f"{w}.{name}: no such joint in the BVH (a joint's name, or "
+                               "'<joint>/end' for the tip of its end site)")
         clicks.append({name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()})
     fit_lengths = _field(d, "fit_lengths", where, bool) if "fit_lengths" in d else True
     return FitJob(sk, bvh, pose_from_bvh(init_bvh, frame, cameras), cameras, clicks,

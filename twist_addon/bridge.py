@@ -12,6 +12,7 @@ all three stays fixed; any other is a ball. A hinge's inverse-kinematics limit o
 (Bone Properties > Inverse Kinematics) bounds its angle while tracking: the core hinge angle
 is the bone's own rotation about that axis. A bone's blob runs from its head to its tail with
 the mean of its envelope's head and tail radii; a bone whose envelope radii are zero has none.
+A bone no other bone hangs from ends in its tail: the joint's end site (a hoof, a hand's tip).
 """
 
 from __future__ import annotations
@@ -77,8 +78,10 @@ def skeleton_from_armature(arm) -> Skeleton:
                 limits[j] = getattr(pb, f"ik_min_{xyz}"), getattr(pb, f"ik_max_{xyz}")
         else:
             kinds.append(BALL)
+    # a bone no other bone hangs from ends in its tail: its end site (a hoof, a hand's tip)
+    ends = [[tails[j] - heads[j]] if j not in parents else [] for j in range(len(bones))]
     sk = Skeleton(names=names, parents=parents, offsets=offsets, kinds=kinds, axes=axes,
-                  limits=limits)
+                  end_sites=ends, limits=limits)
     _, s = _object_rotation_and_scale(arm)
     sk.blobs = [bone_blob(j, b.name, heads[j], tails[j] - heads[j],
                           s * (b.head_radius + b.tail_radius) / 2)

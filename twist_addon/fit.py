@@ -29,7 +29,8 @@ from .markers import markers_at, set_marker
 
 def read_markers_csv(path: Path, scene) -> int:
     """Load markers from a CSV of ``view, bone, x, y[, frame]`` rows (view: 1-based number or
-    camera name; frame: the scene frame, the current one if left out; a header row is
+    camera name; bone: a bone's name for its head, ``<bone>/end`` for the tail of one that
+    ends a limb; frame: the scene frame, the current one if left out; a header row is
     skipped) into the scene's views; returns how many were read."""
     tw = scene.twist
     by_name = {v.camera.name: v for v in tw.views if v.camera}
@@ -96,9 +97,13 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
         raise BridgeError("there are no views with cameras to place markers in")
     clicks = [markers_at(v, scene.frame_current) for v in tw.views if v.camera]
     for c in clicks:
-        for bone in c:
+        for name in c:
+            bone, tip, _ = name.partition("/")
             if bone not in sk.names:
                 raise BridgeError(f"a marker names bone '{bone}', which '{arm.name}' lacks")
+            if tip and not sk.end_sites[sk.index(bone)]:
+                raise BridgeError(f"a marker is on the tip of '{bone}', but other bones hang "
+                                  "from it: mark their heads instead")
     R, root = pose_from_armature(arm, sk)
     mode = tw.mode.lower()
     try:

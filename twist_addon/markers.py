@@ -2,7 +2,10 @@
 clicked joints), stored per view and frame, and drawn over the viewport.
 
 A marker is the pixel (x right, y down, origin at the top-left pixel's centre) of a bone's
-head on one view's footage at one frame.
+head on one view's footage at one frame, or of the tail of a bone that ends a limb (no bone
+hangs from it: a hoof, a hand), stored under the name ``"<bone>/end"``. Placing markers
+goes through the bones in order, and from a bone that ends a limb to its tail before the
+next bone.
 """
 
 from __future__ import annotations
@@ -51,10 +54,25 @@ def next_bone(arm, bone: str) -> str:
     return names[(names.index(bone) + 1) % len(names)] if bone in names else names[0]
 
 
+def marker_name(bone: str, tip: bool) -> str:
+    """What a marker of ``bone``'s head (or its tail, ``tip``) is stored as."""
+    return f"{bone}/end" if tip else bone
+
+
+def next_target(arm, bone: str, tip: bool) -> tuple[str, bool]:
+    """What the click after marking ``bone`` (its head, or its tail when ``tip``) marks: the
+    tail of a bone that ends a limb after its head, else the next bone's head."""
+    b = arm.data.bones.get(bone)
+    if not tip and b is not None and not b.children:
+        return bone, True
+    return next_bone(arm, bone), False
+
+
 class TWIST_OT_place_markers(bpy.types.Operator):
     """Click joints on the footage: looking through a view's camera, each click places the
-    marker of the bone chosen in the panel on the current frame and moves on to the next
-    bone. Right-click or Esc finishes, Backspace skips a bone"""
+    marker of the bone chosen in the panel (its head, or its tip) on the current frame and
+    moves on: to the tip of a bone that ends a limb, else to the next bone. Right-click or
+    Esc finishes, Backspace skips one"""
 
     bl_idname = "twist.place_markers"
     bl_label = "Place Markers"
@@ -67,9 +85,15 @@ class TWIST_OT_place_markers(bpy.types.Operator):
             context.area.type == "VIEW_3D"
 
     def _status(self, context):
+        tw = context.scene.twist
         context.workspace.status_text_set(
-            f"Click the head of '{context.scene.twist.marker_bone}' on the footage - "
-            "Backspace: skip, Right-click or Esc: finish")
+            f"Click the {'tip' if tw.marker_tip else 'head'} of '{tw.marker_bone}' on the "
+            "footage - Backspace: skip, Right-click or Esc: finish")
+
+    @staticmethod
+    def _advance(tw) -> None:
+        tw.marker_bone, tw.marker_tip = next_target(tw.armature, tw.marker_bone,
+                                                    tw.marker_tip)
 
     def invoke(self, context, event):
         scene = context.scene
@@ -95,7 +119,7 @@ class TWIST_OT_place_markers(bpy.types.Operator):
             context.workspace.status_text_set(None)
             return {"FINISHED"}
         if event.type == "BACK_SPACE" and event.value == "PRESS":
-            tw.marker_bone = next_bone(tw.armature, tw.marker_bone)
+            self._advance(tw)
             self._status(context)
             return {"RUNNING_MODAL"}
         if event.type == "LEFTMOUSE" and event.value == "PRESS":
@@ -112,8 +136,9 @@ class TWIST_OT_place_markers(bpy.types.Operator):
             except BridgeError as e:
                 self.report({"ERROR"}, str(e))
                 return {"CANCELLED"}
-            set_marker(view, tw.marker_bone, scene.frame_current, x, y)
-            tw.marker_bone = next_bone(tw.armature, tw.marker_bone)
+            set_marker(view, marker_name(tw.marker_bone, tw.marker_tip), scene.frame_current,
+                       x, y)
+            self._advance(tw)
             self._status(context)
             context.area.tag_redraw()
             return {"RUNNING_MODAL"}

@@ -69,7 +69,9 @@ class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
         layout.prop(tw, "show_overlay")
         box = layout.box()
         if tw.armature is not None:
-            box.prop_search(tw, "marker_bone", tw.armature.data, "bones")
+            row = box.row(align=True)
+            row.prop_search(tw, "marker_bone", tw.armature.data, "bones")
+            row.prop(tw, "marker_tip", toggle=True)
         row = box.row(align=True)
         row.operator("twist.place_markers", icon="RESTRICT_SELECT_OFF")
         row.operator("twist.clear_markers", icon="X", text="")

@@ -131,8 +131,13 @@ class TWIST_PG_scene(bpy.types.PropertyGroup):
     result: bpy.props.PointerProperty(type=TWIST_PG_result)
     marker_bone: bpy.props.StringProperty(
         name="Marker Bone",
-        description="The bone whose head the next click of Place Markers marks; each click "
-                    "moves on to the next bone")
+        description="The bone whose head (or tip) the next click of Place Markers marks; "
+                    "each click moves on: to the tip of a bone that ends a limb, else to the "
+                    "next bone")
+    marker_tip: bpy.props.BoolProperty(
+        name="Tip",
+        description="The next click marks the Marker Bone's tail instead of its head: the end "
+                    "of a limb (a hoof, a hand's tip), for a bone no other bone hangs from")
     show_overlay: bpy.props.BoolProperty(
         name="Show Blobs", default=True,
         description="Draw the outline of every blob over the viewport, to line the armature up "

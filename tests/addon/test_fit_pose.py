@@ -113,3 +113,51 @@ def test_fitting_bone_lengths_writes_them_into_the_rest_pose(bpy_module, registe
     sk = tw.bridge.skeleton_from_armature(arm)
     got = sk.world_positions(*tw.bridge.pose_from_armature(arm, sk))
     assert np.abs(got - truth).max() < 0.01
+
+
+def test_tip_markers_pose_the_bones_that_end_the_limbs(bpy_module, registered):
+    """The horse example's quadruped, one side view: its lower legs and head end in their
+    tails, which only tip markers (``<bone>/end``) can place. Markers on every head and tip
+    of a bent pose bring every tip back onto its marker; heads alone leave the hooves off."""
+    from pathlib import Path
+
+    bpy = bpy_module
+    examples = Path(__file__).resolve().parents[2] / "example_blends"
+    bpy.ops.wm.open_mainfile(filepath=str(examples / "muybridge_horse.blend"))
+    scene = bpy.context.scene
+    tw = registered.twist_addon
+    arm, view_pg = scene.twist.armature, scene.twist.views[0]
+    view = tw.bridge.view_from_camera(view_pg.camera, scene)
+    sk = tw.bridge.skeleton_from_armature(arm)
+    leaves = [n for j, n in enumerate(sk.names) if sk.end_sites[j]]
+    assert len(leaves) == 5  # four hooves and the head
+
+    def tips_and_heads():
+        M = sk.joint_frames(*tw.bridge.pose_from_armature(arm, sk))
+        heads = {n: view.project(M[j, :3, 3][None])[0] for j, n in enumerate(sk.names)}
+        tips = {f"{n}/end": view.project((M[j, :3, :3] @ sk.end_sites[j][0]
+                                          + M[j, :3, 3])[None])[0]
+                for j, n in enumerate(sk.names) if sk.end_sites[j]}
+        return heads, tips
+
+    _random_pose(bpy, arm, sk, np.random.default_rng(4), 0.3, 0.6)
+    heads, tips = tips_and_heads()
+
+    def fit(markers):
+        view_pg.markers.clear()
+        for name, xy in markers.items():
+            tw.markers.set_marker(view_pg, name, scene.frame_current, *xy)
+        for pb in arm.pose.bones:
+            pb.rotation_quaternion, pb.rotation_euler = (1, 0, 0, 0), (0, 0, 0)
+        assert bpy.ops.twist.fit_pose() == {"FINISHED"}
+        bpy.context.view_layer.update()
+        return tips_and_heads()[1]
+
+    got = fit({**heads, **tips})
+    assert max(np.linalg.norm(got[n] - tips[n]) for n in tips) < 0.5  # pixels
+    got = fit(heads)
+    assert max(np.linalg.norm(got[n] - tips[n]) for n in tips) > 5
+    # placing markers runs from a limb's last bone to its tip, then on to the next bone
+    assert tw.markers.next_target(arm, leaves[0], False) == (leaves[0], True)
+    assert tw.markers.next_target(arm, leaves[0], True)[1] is False
+    assert tw.markers.next_target(arm, sk.names[0], False) == (sk.names[1], False)

@@ -322,3 +322,39 @@ def test_degenerate_clicks_get_a_clear_message(cmu_walk):
     good = [{n: views[0].project(X[sk.index(n)]) for n in CLICKED}]
     with pytest.raises(FitError, match="one view cannot tell a longer bone"):
         fit_pose(sk, BodyPose(R, p, views), good, CALIBRATED, fit_lengths=True)
+
+
+def test_the_tips_of_limbs_pin_the_bones_that_end_in_them():
+    """A quadruped seen from its side: its lower legs and head end in end sites, so only
+    clicks on those tips ("<joint>/end") can turn them; with the tips clicked every hinge
+    comes back exactly, without them the lower legs stay as guessed."""
+    from core.skeleton import planar_quadruped_template
+
+    sk = planar_quadruped_template()
+    rng = np.random.default_rng(2)
+    R_true = np.tile(np.eye(3), (sk.n_joints, 1, 1))
+    hinges = [j for j in range(sk.n_joints) if sk.kinds[j] == HINGE]
+    for j in hinges:
+        R_true[j] = se3.exp_so3(sk.axes[j] * np.radians(rng.uniform(-30, 30)))
+    root = sk.rest_positions[0].copy()
+    view = View(se3.Similarity(150.0, np.diag([1.0, -1, -1]), np.array([0, 0, 5.0])),
+                np.array([320.0, 300.0]))
+    M = sk.joint_frames(R_true, root)
+    clicks = {n: view.project(M[j, :3, 3][None])[0] for j, n in enumerate(sk.names)}
+    tips = {f"{n}/end": view.project((M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3])[None])[0]
+            for j, n in enumerate(sk.names) if sk.end_sites[j]}
+    assert len(tips) == 5  # four hooves and the head
+    guess = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), root, [view])
+    both = fit_pose(sk, guess, [{**clicks, **tips}], CALIBRATED, fit_lengths=False)
+    joints_only = fit_pose(sk, guess, [clicks], CALIBRATED, fit_lengths=False)
+    assert both.residual_px < 0.05
+    for j in hinges:
+        err = np.degrees(se3.rotation_angle_between(both.pose.rotations[j], R_true[j]))
+        assert err < 0.1, sk.names[j]
+    lower = [j for j in hinges if sk.end_sites[j] and sk.names[j] != "Head"]
+    missed = [np.degrees(se3.rotation_angle_between(joints_only.pose.rotations[j], R_true[j]))
+              for j in lower]
+    assert max(missed) > 10  # nothing else can turn them
+    with pytest.raises(FitError, match="'Trunk' has no end site"):
+        fit_pose(sk, guess, [{**clicks, "Trunk/end": (0.0, 0.0)}], CALIBRATED,
+                 fit_lengths=False)
