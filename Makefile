@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test lint bench bench-quick bench-walk extension clean
+.PHONY: venv demo test lint bench bench-quick bench-walk bench-plates extension clean
 
 venv: $(STAMP)
 
@@ -39,6 +39,10 @@ bench: venv
 # The suite's quick check for every change: the CMU clips at 15 fps.
 bench-quick: venv
 	$(PY) bench/suite.py --quick $(BENCH_ARGS)
+
+# Muybridge's printed plates tracked from clicked first poses, scored on the animal's outline.
+bench-plates: venv
+	$(PY) bench/plates.py
 
 # The one-clip walk benchmark with its references for one view and one step.
 bench-walk: venv

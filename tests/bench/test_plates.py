@@ -1,0 +1,47 @@
+"""A printed plate tracked end to end: the baboon's, posed by the clicks committed with the
+benchmark, against the animal's silhouette."""
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "bench"))
+
+import plates  # noqa: E402
+
+
+def test_the_planar_body_stands_on_its_clicks():
+    spec = json.loads((plates.DATA / "baboon.json").read_text())
+    sk, pose = plates.planar_body(spec)
+    M = sk.joint_frames(pose.rotations, pose.root_position)
+    view = pose.views[0]
+    for name, xy in spec["clicks"].items():
+        joint, _, end = name.partition("/")
+        j = sk.index(joint)
+        point = M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3] if end else M[j, :3, 3]
+        np.testing.assert_allclose(view.project(point[None])[0], xy, atol=1e-9)
+
+
+def test_the_silhouette_is_the_largest_dark_piece_on_a_light_backdrop():
+    grey = np.full((60, 80), 0.9, np.float32)
+    grey[20:40, 10:50] = 0.3  # the animal
+    grey[5:7, 60:62] = 0.2  # a speck
+    grey[:, 70] = 0.7  # a grid line, barely darker
+    sil = plates.silhouette(grey)
+    assert sil.sum() == 20 * 40 and sil[30, 30] and not sil[6, 61] and not sil[50, 70]
+
+
+def test_the_baboon_tracked_overlaps_its_outline_better_than_its_first_pose_carried():
+    """Measured with the committed clicks: every tracked frame 0.54-0.62 against 0.58 on the
+    first, the first pose carried along 0.41-0.55. Clicks moved by 1.5 pixels (five draws)
+    keep the tracked mean above the carried one by 0.03-0.05, but the worst frame falls to
+    0.24-0.80 of the first's and two of the five stop at a diverged frame: so beyond the
+    committed clicks' run going through, only what held for all of them is asserted."""
+    scores = plates.run("baboon")
+    assert len(scores) == 12 and not any(s.diverged for s in scores)
+    later = scores[1:]
+    assert np.mean([s.tracked for s in later]) > np.mean([s.carried for s in later]) + 0.02
+    assert scores[0].tracked > 0.5  # the clicked pose does line up
