@@ -25,6 +25,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from scipy.ndimage import median_filter
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -80,9 +81,19 @@ def planar_body(spec: dict) -> tuple[Skeleton, BodyPose]:
 
 
 def silhouette(grey: np.ndarray) -> np.ndarray:
-    """The animal in a frame of light backdrop: pixels ``DARKER`` under the frame's light
-    (its 90th percentile), specks and cracks of a pixel removed, the largest piece."""
-    dark = (grey < np.percentile(grey, 90) - DARKER).astype(np.uint8)
+    """The animal in a frame of light backdrop: pixels ``DARKER`` under the light of their
+    part of the frame (each column's 90th percentile, the median over 15 columns: prints
+    darken toward a cell's edges), specks and cracks of a pixel removed, the largest piece.
+    Where the frame ends in dark ground (the camel's), the rows from the ground's edge down
+    are left out (the feet's last pixels with them)."""
+    light = median_filter(np.percentile(grey, 90, axis=0), size=15, mode="nearest")
+    dark = (grey < light - DARKER).astype(np.uint8)
+    light = float(np.median(light))
+    rows = np.median(grey, axis=1)
+    low = len(rows) // 2
+    edge = low + int(np.argmin(np.diff(rows[low:]))) + 1
+    if np.median(rows[edge:]) < light - DARKER:
+        dark[edge:] = 0
     dark = cv2.morphologyEx(dark, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     dark = cv2.morphologyEx(dark, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
     n, labels, stats, _ = cv2.connectedComponentsWithStats(dark)
