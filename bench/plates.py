@@ -47,17 +47,19 @@ PARENT = {"Trunk": None, "Neck": "Trunk", "Head": "Neck",
              for s in ("Left", "Right") for e in ("Fore", "Hind") for p in ("Upper", "Lower")}}
 
 
-def planar_body(spec: dict) -> tuple[Skeleton, BodyPose]:
-    """The quadruped of ``spec`` (clicks, radii, side_apart) and its pose on the first frame:
-    the rest pose, every rotation the identity, seen by an orthographic view of one pixel
-    per world unit looking along -z (world y up, image y down)."""
-    clicks, r, apart = spec["clicks"], spec["radii"], spec["side_apart"]
+def planar_body(spec: dict, unit: float = 1.0) -> tuple[Skeleton, BodyPose]:
+    """The quadruped of ``spec`` (clicks, radii, side_apart: pixels) and its pose on the
+    first frame: the rest pose, every rotation the identity, seen by an orthographic view
+    looking along -z (world y up, image y down) at ``unit`` world units per pixel, whose
+    pixel (0, 0) is the world's origin."""
+    clicks, apart = spec["clicks"], spec["side_apart"]
+    r = {k: np.asarray(v, float) * unit for k, v in spec["radii"].items()}
 
     def at(name: str) -> np.ndarray:
         x, y = clicks[name]
         side = name.split("/")[0]
         z = apart if side.startswith("Left") else -apart if side.startswith("Right") else 0
-        return np.array([x, -y, z], float)
+        return np.array([x, -y, z], float) * unit
 
     names = list(PARENT)
     pos = {n: at(n) for n in names}
@@ -68,15 +70,15 @@ def planar_body(spec: dict) -> tuple[Skeleton, BodyPose]:
                   ends)
     # the trunk from a little behind and below the rump to a little past the neck's base
     chest = pos["Neck"] - pos["Trunk"]
-    sk.blobs = [bone_blob(0, "Trunk", pos["Trunk"] + (-4, -4, 0), chest + (8, 0, 0),
-                          tuple(r["trunk"]))]
+    sk.blobs = [bone_blob(0, "Trunk", pos["Trunk"] + np.array([-4, -4, 0]) * unit,
+                          chest + np.array([8, 0, 0]) * unit, tuple(r["trunk"]))]
     for j, n in enumerate(names[1:], 1):
         kids = sk.children(j)
         tip = ends[j][0] if ends[j] else offsets[kids[0]]
-        sk.blobs.append(bone_blob(j, n, pos[n], tip, r["neck"] if n in ("Neck", "Head")
-                                  else r["limb"]))
-    view = View(se3.Similarity(1.0, np.diag([1.0, -1.0, -1.0]), np.array([0, 0, 100.0])),
-                np.zeros(2))
+        sk.blobs.append(bone_blob(j, n, pos[n], tip, float(r["neck"] if n in ("Neck", "Head")
+                                                           else r["limb"])))
+    view = View(se3.Similarity(1.0 / unit, np.diag([1.0, -1.0, -1.0]),
+                               np.array([0, 0, 100.0 * unit])), np.zeros(2))
     return sk, BodyPose(np.tile(np.eye(3), (len(names), 1, 1)), pos["Trunk"].copy(), [view])
 
 
