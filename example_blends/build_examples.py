@@ -12,6 +12,12 @@ camera, and the planar quadruped template placed and scaled over the horse on pl
 muybridge_woman.blend: a woman jumping, with the 19-degree-of-freedom human placed over her.
 Their limbs are left for the user to pose over the first plate; both track side-on (one view).
 
+muybridge_baboon.blend, muybridge_camel.blend: a printed plate of muybridge_plates/ cut into
+its cells by Add View from Plate (the frames in muybridge_plates/plate_NAME_frames/), and the
+planar quadruped of bench/plates.py standing on the joints clicked on its first frame
+(bench/data/plates/NAME.json; the clicks are the view's markers there, so Fit Pose to
+Markers gives the pose back), a centimetre per pixel: ready for Track.
+
 Paths are relative to each .blend, so the folder can move.
 """
 
@@ -32,10 +38,13 @@ sys.path.insert(0, str(ROOT / "bench"))
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from addon_dev import load_addon  # noqa: E402
+from plates import DATA as PLATE_CLICKS  # noqa: E402
+from plates import planar_body  # noqa: E402
 from walk_footage import SPINE_JOINTS, render, tracking_scene  # noqa: E402
 
 WALK = dict(first=540, last=660, step=8)  # capture frames: one second at 15 fps
 VIEWS = ["lateral", "endon", "oblique60"]
+PLATE_UNIT = 0.01  # metres per pixel of a plate's frames: the animals about a metre long
 
 
 def build_walk(bpy) -> Path:
@@ -89,10 +98,41 @@ def build_plates(bpy, name: str, template: str, ortho_scale: float, location: tu
     return path
 
 
+def build_plate(bpy, twist_addon, name: str) -> Path:
+    """A printed plate cut into a view, with the planar quadruped clicked on its first frame
+    (see the module's docstring)."""
+    import json
+
+    spec = json.loads((PLATE_CLICKS / f"{name}.json").read_text())
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    path = HERE / f"muybridge_{name}.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
+    scene = bpy.context.scene
+    view = scene.twist.views[0]
+    W, H = scene.render.resolution_x, scene.render.resolution_y
+    cam = view.camera  # looking along +y, x right, z up: pixel (x, y) at (x, -y) / unit
+    cam.data.ortho_scale = W * PLATE_UNIT
+    cam.location = ((W - 1) / 2 * PLATE_UNIT, -10.0, -(H - 1) / 2 * PLATE_UNIT)
+    sk, _ = planar_body(spec, PLATE_UNIT)
+    arm = twist_addon.bridge.armature_from_skeleton(sk, name.title(), scene.collection)
+    scene.twist.armature = arm
+    scene.twist.mode = "INDEPENDENT"
+    scene.twist.tracker.side_on = True
+    for bone, xy in spec["clicks"].items():
+        twist_addon.markers.set_marker(view, bone, 1, *xy)
+    scene.render.fps = 15
+    scene.camera = cam
+    scene.frame_set(1)
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), relative_remap=True)
+    return path
+
+
 def main() -> int:
     import bpy
 
-    load_addon().register()  # its classes outlive the factory resets below
+    addon = load_addon()
+    addon.register()  # its classes outlive the factory resets below
     print(build_walk(bpy))
     # the horse: the quadruped's trunk along the barrel (rump at (88, 92)), its poll near the
     # ears, 70 px per metre across the 300 x 200 plates
@@ -101,6 +141,8 @@ def main() -> int:
     # metre down the plates (padded to 202 x 376); the human turned to face the image's right
     print(build_plates(bpy, "muybridge_woman", "HUMAN", 376 / 160, (0.097125, -10.0, 0.984375),
                        turn_deg=90))
+    for name in ("baboon", "camel"):
+        print(build_plate(bpy, addon.twist_addon, name))
     return 0
 
 

@@ -74,7 +74,7 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
         type=bpy.types.Object, poll=_is_camera, name="Camera",
         description="The orthographic camera the footage was seen through")
     images: bpy.props.StringProperty(
-        name="Footage", subtype="FILE_PATH",
+        name="Footage", subtype="FILE_PATH", options={"PATH_SUPPORTS_BLEND_RELATIVE"},
         description="The footage's frames: a glob such as //walk/side_*.png (// is the .blend's "
                     "folder), read in name order")
     first_frame: first_frame_property()
