@@ -5,7 +5,9 @@
 Opens example_blends/walk_3view.blend, runs Track, saves the tracked .blend, exports the
 motion as BVH and FBX with Blender's exporters, draws the tracked blobs over the footage into
 a contact sheet, and prints where each file went and how far the tracked limbs are from the
-motion capture the footage was rendered from.
+motion capture the footage was rendered from. Then the same for a Muybridge plate,
+example_blends/muybridge_camel.blend, scored by how well each frame's tracked outline
+covers the camel.
 """
 
 from __future__ import annotations
@@ -25,9 +27,11 @@ from addon_dev import load_addon  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
+from core.pose import BodyPose  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
 EXAMPLE = ROOT / "example_blends" / "walk_3view.blend"
+PLATE_EXAMPLE = ROOT / "example_blends" / "muybridge_camel.blend"
 
 
 def contact_sheet(bpy, bridge, scene, path: Path, frames: list[int]) -> None:
@@ -57,6 +61,61 @@ def contact_sheet(bpy, bridge, scene, path: Path, frames: list[int]) -> None:
     cv2.imwrite(str(path), np.vstack(rows))
 
 
+def export(bpy, scene, paths: dict) -> None:
+    """The tracked .blend, and the armature's motion as BVH and FBX, to ``paths``."""
+    bpy.ops.wm.save_as_mainfile(filepath=str(paths["tracked .blend"]), copy=True)
+    arm = scene.twist.armature
+    bpy.ops.object.select_all(action="DESELECT")
+    arm.select_set(True)
+    bpy.context.view_layer.objects.active = arm
+    bpy.ops.export_anim.bvh(filepath=str(paths["BVH"]), frame_start=scene.frame_start,
+                            frame_end=scene.frame_end)
+    bpy.ops.export_scene.fbx(filepath=str(paths["FBX"]), use_selection=True,
+                             object_types={"ARMATURE"}, add_leaf_bones=False, bake_anim=True,
+                             bake_anim_simplify_factor=0.0)
+
+
+def plate_demo(bpy, bridge, out: Path) -> int:
+    """The camel's plate tracked, exported and drawn; prints each frame's overlap of the
+    tracked outline with the camel."""
+    import plates
+
+    bpy.ops.wm.open_mainfile(filepath=str(PLATE_EXAMPLE))
+    scene = bpy.context.scene
+    scene.frame_set(scene.frame_start)
+    print(f"\ntracking {PLATE_EXAMPLE.name}: one view, frames {scene.frame_start}-"
+          f"{scene.frame_end}", flush=True)
+    if bpy.ops.twist.track() != {"FINISHED"}:
+        return 1
+    stem = PLATE_EXAMPLE.stem
+    paths = {"tracked .blend": out / f"{stem}_tracked.blend", "BVH": out / f"{stem}.bvh",
+             "FBX": out / f"{stem}.fbx", "contact sheet": out / f"{stem}_contact_sheet.png"}
+    export(bpy, scene, paths)
+    n = scene.frame_end - scene.frame_start + 1
+    contact_sheet(bpy, bridge, scene, paths["contact sheet"],
+                  [scene.frame_start + i * (n - 1) // 3 for i in range(4)])
+    view_pg = scene.twist.views[0]
+    view = bridge.view_from_camera(view_pg.camera, scene)
+    arm = scene.twist.armature
+    sk = bridge.skeleton_from_armature(arm)
+    files = sorted(Path(bpy.path.abspath(view_pg.images)).parent.glob(
+        Path(view_pg.images).name))
+    overlaps = []
+    for f in range(scene.frame_start, scene.frame_start + scene.twist.result.frames_tracked
+                   + 1):
+        scene.frame_set(f)
+        R, root = bridge.pose_from_armature(arm, sk)
+        sil = plates.silhouette(cv2.imread(str(files[f - view_pg.first_frame]),
+                                           cv2.IMREAD_GRAYSCALE) / 255.0)
+        pose = BodyPose(R, root, [view])
+        overlaps.append(plates.overlap(plates.outline(sk, pose, sil.shape), sil))
+    for label, p in paths.items():
+        print(f"{label:14s} {p}")
+    print(f"overlap of the tracked outline with the camel, frame by frame: "
+          f"{', '.join(f'{o:.2f}' for o in overlaps)} (the first frame is the clicked pose)")
+    return 0
+
+
 def main(argv=None) -> int:
     import bpy
 
@@ -81,16 +140,8 @@ def main(argv=None) -> int:
         "FBX": a.out / "walk_3view.fbx",
         "contact sheet": a.out / "walk_3view_contact_sheet.png",
     }
-    bpy.ops.wm.save_as_mainfile(filepath=str(paths["tracked .blend"]), copy=True)
+    export(bpy, scene, paths)
     arm = scene.twist.armature
-    bpy.ops.object.select_all(action="DESELECT")
-    arm.select_set(True)
-    bpy.context.view_layer.objects.active = arm
-    bpy.ops.export_anim.bvh(filepath=str(paths["BVH"]), frame_start=scene.frame_start,
-                            frame_end=scene.frame_end)
-    bpy.ops.export_scene.fbx(filepath=str(paths["FBX"]), use_selection=True,
-                             object_types={"ARMATURE"}, add_leaf_bones=False, bake_anim=True,
-                             bake_anim_simplify_factor=0.0)
     n = scene.frame_end - scene.frame_start + 1
     contact_sheet(bpy, bridge, scene, paths["contact sheet"],
                   [scene.frame_start + i * (n - 1) // 3 for i in range(4)])
@@ -117,7 +168,7 @@ def main(argv=None) -> int:
           f"{np.mean([got.limb_deg[k] for k in legs]):.1f} deg, all eight limbs "
           f"{got.limb_mean_deg:.1f} deg (first frame held still: {still.limb_mean_deg:.1f} deg)")
     print("per limb (deg): " + ", ".join(f"{k} {v:.1f}" for k, v in got.limb_deg.items()))
-    return 0
+    return plate_demo(bpy, bridge, a.out)
 
 
 if __name__ == "__main__":
