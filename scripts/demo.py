@@ -75,17 +75,24 @@ def export(bpy, scene, paths: dict) -> None:
                              bake_anim_simplify_factor=0.0)
 
 
+def open_and_track(bpy, path: Path):
+    """Open an example scene and Track it from its first frame; the scene, or None when
+    Track did not go through."""
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    scene = bpy.context.scene
+    scene.frame_set(scene.frame_start)
+    print(f"\ntracking {path.name}: {len(scene.twist.views)} view(s), frames "
+          f"{scene.frame_start}-{scene.frame_end}", flush=True)
+    return scene if bpy.ops.twist.track() == {"FINISHED"} else None
+
+
 def plate_demo(bpy, bridge, out: Path) -> int:
     """The camel's plate tracked, exported and drawn; prints each frame's overlap of the
     tracked outline with the camel."""
     import plates
 
-    bpy.ops.wm.open_mainfile(filepath=str(PLATE_EXAMPLE))
-    scene = bpy.context.scene
-    scene.frame_set(scene.frame_start)
-    print(f"\ntracking {PLATE_EXAMPLE.name}: one view, frames {scene.frame_start}-"
-          f"{scene.frame_end}", flush=True)
-    if bpy.ops.twist.track() != {"FINISHED"}:
+    scene = open_and_track(bpy, PLATE_EXAMPLE)
+    if scene is None:
         return 1
     stem = PLATE_EXAMPLE.stem
     paths = {"tracked .blend": out / f"{stem}_tracked.blend", "BVH": out / f"{stem}.bvh",
@@ -123,15 +130,11 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=ROOT / ".cache" / "demo")
     a = ap.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)
-    bpy.ops.wm.open_mainfile(filepath=str(EXAMPLE))
     addon = load_addon()
     addon.register()
     bridge = addon.twist_addon.bridge
-    scene = bpy.context.scene
-    scene.frame_set(scene.frame_start)
-    print(f"tracking {EXAMPLE.name}: {len(scene.twist.views)} views, frames "
-          f"{scene.frame_start}-{scene.frame_end}", flush=True)
-    if bpy.ops.twist.track() != {"FINISHED"}:
+    scene = open_and_track(bpy, EXAMPLE)
+    if scene is None:
         return 1
     result = scene.twist.result
     paths = {

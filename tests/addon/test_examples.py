@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.views import one_view_example, projected_points
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "example_blends"
 
 
@@ -64,24 +66,13 @@ def test_a_plates_example_stands_on_its_clicks_and_tracks_through(bpy_module, re
     0.48-0.57 on the tracked frames against 0.55 on the first (bench/plates.py measures the
     benchmark's own body)."""
     bpy = bpy_module
-    bpy.ops.wm.open_mainfile(filepath=str(EXAMPLES / "muybridge_camel.blend"))
-    scene = bpy.context.scene
+    scene, arm, view_pg, view, sk = one_view_example(bpy, registered, "muybridge_camel.blend")
     tw = registered.twist_addon
-    arm, view_pg = scene.twist.armature, scene.twist.views[0]
-    view = tw.bridge.view_from_camera(view_pg.camera, scene)
-    sk = tw.bridge.skeleton_from_armature(arm)
     clicks = tw.markers.markers_at(view_pg, 1)
     assert len(clicks) == 16
 
     def projected():
-        M = sk.joint_frames(*tw.bridge.pose_from_armature(arm, sk))
-        out = {}
-        for name in clicks:
-            joint, _, end = name.partition("/")
-            j = sk.index(joint)
-            X = M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3] if end else M[j, :3, 3]
-            out[name] = view.project(X[None])[0]
-        return out
+        return projected_points(tw.bridge, arm, sk, view, clicks)
 
     at_rest = projected()
     assert max(np.linalg.norm(at_rest[n] - clicks[n]) for n in clicks) < 0.01

@@ -6,6 +6,7 @@ import re
 import numpy as np
 import pytest
 
+from support.views import one_view_example, projected_points
 from support.views import three_view_scene as _scene_with_views
 
 
@@ -119,26 +120,16 @@ def test_tip_markers_pose_the_bones_that_end_the_limbs(bpy_module, registered):
     """The horse example's quadruped, one side view: its lower legs and head end in their
     tails, which only tip markers (``<bone>/end``) can place. Markers on every head and tip
     of a bent pose bring every tip back onto its marker; heads alone leave the hooves off."""
-    from pathlib import Path
-
     bpy = bpy_module
-    examples = Path(__file__).resolve().parents[2] / "example_blends"
-    bpy.ops.wm.open_mainfile(filepath=str(examples / "muybridge_horse.blend"))
-    scene = bpy.context.scene
+    scene, arm, view_pg, view, sk = one_view_example(bpy, registered, "muybridge_horse.blend")
     tw = registered.twist_addon
-    arm, view_pg = scene.twist.armature, scene.twist.views[0]
-    view = tw.bridge.view_from_camera(view_pg.camera, scene)
-    sk = tw.bridge.skeleton_from_armature(arm)
     leaves = [n for j, n in enumerate(sk.names) if sk.end_sites[j]]
     assert len(leaves) == 5  # four hooves and the head
+    ends = [f"{n}/end" for n in leaves]
 
     def tips_and_heads():
-        M = sk.joint_frames(*tw.bridge.pose_from_armature(arm, sk))
-        heads = {n: view.project(M[j, :3, 3][None])[0] for j, n in enumerate(sk.names)}
-        tips = {f"{n}/end": view.project((M[j, :3, :3] @ sk.end_sites[j][0]
-                                          + M[j, :3, 3])[None])[0]
-                for j, n in enumerate(sk.names) if sk.end_sites[j]}
-        return heads, tips
+        points = projected_points(tw.bridge, arm, sk, view, sk.names + ends)
+        return ({n: points[n] for n in sk.names}, {n: points[n] for n in ends})
 
     _random_pose(bpy, arm, sk, np.random.default_rng(4), 0.3, 0.6)
     heads, tips = tips_and_heads()

@@ -23,3 +23,30 @@ def three_view_scene(bpy, registered):
         view.camera = cam
     bpy.context.view_layer.update()
     return scene, scene.twist.armature
+
+
+def one_view_example(bpy, registered, name: str):
+    """An example scene of one view opened: (scene, armature, the view's item, its core
+    ``View``, the armature's core skeleton)."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[2] / "example_blends"
+    bpy.ops.wm.open_mainfile(filepath=str(examples / name))
+    scene = bpy.context.scene
+    tw = registered.twist_addon
+    arm, view_pg = scene.twist.armature, scene.twist.views[0]
+    view = tw.bridge.view_from_camera(view_pg.camera, scene)
+    return scene, arm, view_pg, view, tw.bridge.skeleton_from_armature(arm)
+
+
+def projected_points(bridge, arm, sk, view, names) -> dict:
+    """Where ``view`` shows each named point of the armature's current pose: a joint, or
+    ``"<joint>/end"``, the tip of its end site."""
+    M = sk.joint_frames(*bridge.pose_from_armature(arm, sk))
+    out = {}
+    for name in names:
+        joint, _, end = name.partition("/")
+        j = sk.index(joint)
+        X = M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3] if end else M[j, :3, 3]
+        out[name] = view.project(X[None])[0]
+    return out
