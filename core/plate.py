@@ -119,15 +119,14 @@ def backdrop_mask(cell: np.ndarray) -> np.ndarray:
     return cv2.dilate(body, np.ones((7, 7), np.uint8)) == 0
 
 
-def _profile(cell: np.ndarray, axis: int) -> np.ndarray:
-    """The median brightness of the cell's backdrop along ``axis`` (0: per column, 1: per
-    row), less its running mean: the grid's lines and the ground's edge, with the animal
-    and the light's slow falloff left out (a line the animal covers whole reads as the
-    median of the whole line)."""
+def _row_profile(cell: np.ndarray) -> np.ndarray:
+    """The median brightness of each row of the cell's backdrop, less its running mean: the
+    grid's lines and the ground's edge, with the animal and the light's slow falloff left
+    out (a row the animal covers whole reads as the median of the whole row)."""
     masked = np.where(backdrop_mask(cell), cell, np.nan)
-    seen = ~np.all(np.isnan(masked), axis=axis)
-    p = np.median(cell, axis=axis)
-    p[seen] = np.nanmedian(np.compress(seen, masked, axis=1 - axis), axis=axis)
+    seen = ~np.all(np.isnan(masked), axis=1)
+    p = np.median(cell, axis=1)
+    p[seen] = np.nanmedian(masked[seen], axis=1)
     k = max(3, len(p) // 8) | 1
     return p - np.convolve(np.pad(p, k // 2, mode="edge"), np.ones(k) / k, mode="valid")
 
@@ -154,14 +153,19 @@ def _shift(ref: np.ndarray, cur: np.ndarray, most: int) -> float:
 
 def register(reference: np.ndarray, cell: np.ndarray) -> np.ndarray:
     """Offset (2,) of ``cell`` against ``reference`` (grey cells, any sizes): the cell's
-    pixel at ``p + offset`` shows what the reference shows at p. Down: from the backdrop's
-    rows (the ground's edge, the measuring grid's lines; ``_profile``), searched within a
-    tenth of the cell's height, as crops differ by a few pixels. Across: none. The
-    cameras stood side by side, so each cell shows another stretch of the grid, and its
-    columns repeat: on the three plates tried, matching them jumped 6 to 15 pixels
-    between neighbouring cells, a grid square's width, not the crop's error."""
-    most = max(2, reference.shape[0] // 10)
-    return np.array([0.0, _shift(_profile(reference, 1), _profile(cell, 1), most)])
+    pixel at ``p + offset`` shows what the reference shows at p (``_offset``)."""
+    return _offset(_row_profile(reference), cell)
+
+
+def _offset(reference_rows: np.ndarray, cell: np.ndarray) -> np.ndarray:
+    """``register`` against a reference cell's ``_row_profile``. Down: from the backdrop's
+    rows (the ground's edge, the measuring grid's lines), searched within a tenth of the
+    cell's height, as crops differ by a few pixels. Across: none. The cameras stood side
+    by side, so each cell shows another stretch of the grid, and its columns repeat: on
+    the three plates tried, matching them jumped 6 to 15 pixels between neighbouring
+    cells, a grid square's width, not the crop's error."""
+    most = max(2, len(reference_rows) // 10)
+    return np.array([0.0, _shift(reference_rows, _row_profile(cell), most)])
 
 
 def import_plate(grey: np.ndarray, per_row: int | None = None
@@ -171,9 +175,10 @@ def import_plate(grey: np.ndarray, per_row: int | None = None
     boxes = find_cells(grey, per_row)
     crops = [grey[y0:y1, x0:x1] for x0, y0, x1, y1 in boxes]
     first = crops[0]
+    first_rows = _row_profile(first)  # each cell is matched against it
     cells, frames = [], []
     for box, crop in zip(boxes, crops):
-        offset = np.zeros(2) if crop is first else register(first, crop)
+        offset = np.zeros(2) if crop is first else _offset(first_rows, crop)
         cells.append(Cell(box, offset))
         warp = np.array([[1, 0, offset[0]], [0, 1, offset[1]]], np.float32)
         frames.append(cv2.warpAffine(crop.astype(np.float32), warp,
