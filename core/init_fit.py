@@ -71,16 +71,18 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     hoof that ends a limb, whose length the fit keeps)."""
     if len(clicks) != len(guess.views):
         raise FitError(f"clicks for {len(clicks)} views, but {len(guess.views)} views")
+    points = []  # per view, each click's (joint, whether at its end site)
     for c, view_clicks in enumerate(clicks):
-        for name in view_clicks:
-            _clicked_point(sk, name, f"view {c + 1}")
+        try:
+            points.append([clicked_point(sk, name) for name in view_clicks])
+        except FitError as e:
+            raise FitError(f"view {c + 1}: {e}") from None
     dof_joint, dof_axis = sk.dof_joints_and_axes()
     joints = sorted(set(dof_joint.tolist()))
     # a bone on the way from the root to a clicked joint gets its own length (shared with
     # its mirror twin): even an unclicked trunk bone decides where the clicked shoulders can
     # be (one common factor for them left the upper arms 2 degrees off with exact clicks);
     # bones below every click scale with one common factor, so that they do not soak up noise
-    points = [[_clicked_point(sk, n, "") for n in v] for v in clicks]  # (joint, at its end)
     clicked = {j for v in points for j, _ in v}  # a clicked end counts as its joint here
     on_path = {a for c in clicked for a in sk.ancestors(c)}  # clicked joints and above
 
@@ -189,16 +191,17 @@ def least_certain(uncertainty: dict[str, float], n: int = 3, views: int = 2) -> 
     return "; ".join(parts) or "none turned"
 
 
-def _clicked_point(sk: Skeleton, name: str, where: str) -> tuple[int, bool]:
+def clicked_point(sk: Skeleton, name: str) -> tuple[int, bool]:
     """The joint a click names and whether it is at the joint's end site (``"Knee/end"``);
     FitError for a name the skeleton lacks."""
     joint, slash, end = name.partition("/")
     if joint not in sk.names or (slash and end != "end"):
-        raise FitError(f"{where}: no joint named '{name}'" if where else name)
+        raise FitError(f"no joint named '{name}' (a joint's name, or '<joint>/end' for the "
+                       "tip of its end site)")
     j = sk.index(joint)
     if slash and not sk.end_sites[j]:
-        raise FitError(f"{where}: '{joint}' has no end site to click ('{name}'): click a "
-                       "joint, or the end of a bone that ends a limb")
+        raise FitError(f"'{joint}' has no end site to click ('{name}'): click a joint, or "
+                       "the end of a bone that ends a limb")
     return j, bool(slash)
 
 

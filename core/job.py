@@ -21,6 +21,7 @@ from .bvh import BvhError, BvhFile, read_bvh
 from .camera import View
 from .errors import InputError
 from .image import ImageError
+from .init_fit import FitError, clicked_point
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, pose_from_bvh
 from .settings import TrackerSettings
 from .skeleton import BALL, FIXED, HINGE, Skeleton, skeleton_from_bvh
@@ -347,10 +348,10 @@ def load_fit(path: str | Path) -> FitJob:
         if not isinstance(c, dict):
             raise JobError(f"{w}: expected an object of joint name -> [x, y]")
         for name in c:
-            joint, slash, end = name.partition("/")
-            if joint not in sk.names or (slash and end != "end"):
-                raise JobError(f"{w}.{name}: no such joint in the BVH (a joint's name, or "
-                               "'<joint>/end' for the tip of its end site)")
+            try:
+                clicked_point(sk, name)
+            except FitError as e:
+                raise JobError(f"{w}.{name}: {e}") from None
         clicks.append({name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()})
     fit_lengths = _field(d, "fit_lengths", where, bool) if "fit_lengths" in d else True
     return FitJob(sk, bvh, pose_from_bvh(init_bvh, frame, cameras), cameras, clicks,

@@ -98,12 +98,9 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
     clicks = [markers_at(v, scene.frame_current) for v in tw.views if v.camera]
     for c in clicks:
         for name in c:
-            bone, tip, _ = name.partition("/")
+            bone = name.partition("/")[0]  # a tip's marker: fit_pose checks it has one
             if bone not in sk.names:
                 raise BridgeError(f"a marker names bone '{bone}', which '{arm.name}' lacks")
-            if tip and not sk.end_sites[sk.index(bone)]:
-                raise BridgeError(f"a marker is on the tip of '{bone}', but other bones hang "
-                                  "from it: mark their heads instead")
     R, root = pose_from_armature(arm, sk)
     mode = tw.mode.lower()
     try:
