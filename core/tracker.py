@@ -38,6 +38,12 @@ def frames_tracked(results: Sequence[FrameResult]) -> int:
     return sum(not r.diverged for r in results[1:])
 
 
+def frames_to_check(results: Sequence[FrameResult]) -> dict[int, dict[str, str]]:
+    """The tracked frames of a run's results with limbs flagged, and those limbs' flags
+    (``FrameResult.flagged``). The report and the add-on list the same frames."""
+    return {r.frame: r.flagged for r in results if r.flagged and not r.diverged}
+
+
 
 @dataclass
 class TrackResult:
@@ -51,8 +57,7 @@ class TrackResult:
 
     @property
     def frames_to_check(self) -> dict[int, dict[str, str]]:
-        """Tracked frames with limbs flagged, and those limbs' flags."""
-        return {f.frame: f.flagged for f in self.frames if f.flagged and not f.diverged}
+        return frames_to_check(self.frames)
 
 
 

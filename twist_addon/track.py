@@ -14,7 +14,7 @@ import bpy
 from ..core.confidence import frame_list
 from ..core.frame_fit import FrameResult
 from ..core.pose import BodyPose, world_pose
-from ..core.tracker import Tracker, frames_tracked
+from ..core.tracker import Tracker, frames_to_check, frames_tracked
 from . import checks, keyframes
 from .armature_action import ArmatureAction
 from .bridge import (
@@ -95,7 +95,7 @@ class TrackSession:
 
     def frames_to_check(self) -> list[int]:
         """Scene frames tracked with a limb flagged."""
-        return [self.frames[r.frame] for r in self.tracked if r.flagged and not r.diverged]
+        return [self.frames[f] for f in frames_to_check(self.tracked)]
 
     def run(self, scene):
         """Yield after each frame is tracked and keyed, and marked on the timeline when a
