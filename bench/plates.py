@@ -104,18 +104,15 @@ def silhouette(grey: np.ndarray) -> np.ndarray:
     return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
 
 
-def outline(sk: Skeleton, pose: BodyPose, shape) -> np.ndarray:
-    """The pixels the body's blobs cover at ``pose`` in its one view."""
+def overlap(sk: Skeleton, pose: BodyPose, sil: np.ndarray) -> float:
+    """Intersection over union of the pixels the body's blobs cover at ``pose`` in its one
+    view with the silhouette ``sil`` (boolean, the frame's size)."""
     pix, _, box = raycast.render_labels(pose.views[0], sk.blobs,
-                                        Kinematics(sk, pose).segments, shape, 1)
-    mask = np.zeros(shape, bool)
+                                        Kinematics(sk, pose).segments, sil.shape, 1)
+    covered = np.zeros(sil.shape, bool)
     if box is not None:
-        mask[pix[:, 1].astype(int), pix[:, 0].astype(int)] = True
-    return mask
-
-
-def overlap(a: np.ndarray, b: np.ndarray) -> float:
-    return float((a & b).sum() / max((a | b).sum(), 1))
+        covered[pix[:, 1].astype(int), pix[:, 0].astype(int)] = True
+    return float((covered & sil).sum() / max((covered | sil).sum(), 1))
 
 
 @dataclass
@@ -146,8 +143,8 @@ def run(name: str) -> list[FrameScore]:
 
 
 def _score(sk: Skeleton, fr: FrameResult, sil: np.ndarray, carried: BodyPose) -> FrameScore:
-    return FrameScore(fr.frame + 1, overlap(outline(sk, fr.pose, sil.shape), sil),
-                      overlap(outline(sk, carried, sil.shape), sil), fr.flagged, fr.diverged)
+    return FrameScore(fr.frame + 1, overlap(sk, fr.pose, sil), overlap(sk, carried, sil),
+                      fr.flagged, fr.diverged)
 
 
 def main(argv=None) -> int:

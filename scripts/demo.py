@@ -27,6 +27,7 @@ from addon_dev import load_addon  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
+from core.image import load_grey  # noqa: E402
 from core.pose import BodyPose  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
@@ -34,9 +35,9 @@ EXAMPLE = ROOT / "example_blends" / "walk_3view.blend"
 PLATE_EXAMPLE = ROOT / "example_blends" / "muybridge_camel.blend"
 
 
-def contact_sheet(bpy, bridge, scene, path: Path, frames: list[int]) -> None:
+def contact_sheet(twist_addon, scene, path: Path, frames: list[int]) -> None:
     """Rows of frames, one column per view: the footage with the tracked blobs' outlines."""
-    tw = scene.twist
+    bridge, tw = twist_addon.bridge, scene.twist
     rows = []
     for f in frames:
         scene.frame_set(f)
@@ -45,8 +46,7 @@ def contact_sheet(bpy, bridge, scene, path: Path, frames: list[int]) -> None:
         g = sk.segment_motions(sk.joint_frames(R, root))
         row = []
         for v in tw.views:
-            img = cv2.imread(sorted(Path(bpy.path.abspath(v.images)).parent.glob(
-                Path(v.images).name))[f - v.first_frame].as_posix())
+            img = cv2.imread(str(twist_addon.views.footage_frames(v, [f])[0]))
             view = bridge.view_from_camera(v.camera, scene)
             pix, hits, _ = raycast.render_labels(view, sk.blobs, g, img.shape[:2])
             lab = np.full(img.shape[:2], -1)
@@ -86,7 +86,7 @@ def open_and_track(bpy, path: Path):
     return scene if bpy.ops.twist.track() == {"FINISHED"} else None
 
 
-def plate_demo(bpy, bridge, out: Path) -> int:
+def plate_demo(bpy, twist_addon, out: Path) -> int:
     """The camel's plate tracked, exported and drawn; prints each frame's overlap of the
     tracked outline with the camel."""
     import plates
@@ -99,23 +99,20 @@ def plate_demo(bpy, bridge, out: Path) -> int:
              "FBX": out / f"{stem}.fbx", "contact sheet": out / f"{stem}_contact_sheet.png"}
     export(bpy, scene, paths)
     n = scene.frame_end - scene.frame_start + 1
-    contact_sheet(bpy, bridge, scene, paths["contact sheet"],
+    contact_sheet(twist_addon, scene, paths["contact sheet"],
                   [scene.frame_start + i * (n - 1) // 3 for i in range(4)])
-    view_pg = scene.twist.views[0]
+    bridge, view_pg = twist_addon.bridge, scene.twist.views[0]
     view = bridge.view_from_camera(view_pg.camera, scene)
     arm = scene.twist.armature
     sk = bridge.skeleton_from_armature(arm)
-    files = sorted(Path(bpy.path.abspath(view_pg.images)).parent.glob(
-        Path(view_pg.images).name))
+    frames = range(scene.frame_start, scene.frame_start + scene.twist.result.frames_tracked + 1)
     overlaps = []
-    for f in range(scene.frame_start, scene.frame_start + scene.twist.result.frames_tracked
-                   + 1):
+    for f, image in zip(frames, twist_addon.views.footage_frames(view_pg, list(frames))):
         scene.frame_set(f)
         R, root = bridge.pose_from_armature(arm, sk)
-        sil = plates.silhouette(cv2.imread(str(files[f - view_pg.first_frame]),
-                                           cv2.IMREAD_GRAYSCALE) / 255.0)
+        sil = plates.silhouette(load_grey(image))
         pose = BodyPose(R, root, [view])
-        overlaps.append(plates.overlap(plates.outline(sk, pose, sil.shape), sil))
+        overlaps.append(plates.overlap(sk, pose, sil))
     for label, p in paths.items():
         print(f"{label:14s} {p}")
     print(f"overlap of the tracked outline with the camel, frame by frame: "
@@ -132,7 +129,8 @@ def main(argv=None) -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     addon = load_addon()
     addon.register()
-    bridge = addon.twist_addon.bridge
+    twist_addon = addon.twist_addon
+    bridge = twist_addon.bridge
     scene = open_and_track(bpy, EXAMPLE)
     if scene is None:
         return 1
@@ -146,7 +144,7 @@ def main(argv=None) -> int:
     export(bpy, scene, paths)
     arm = scene.twist.armature
     n = scene.frame_end - scene.frame_start + 1
-    contact_sheet(bpy, bridge, scene, paths["contact sheet"],
+    contact_sheet(twist_addon, scene, paths["contact sheet"],
                   [scene.frame_start + i * (n - 1) // 3 for i in range(4)])
 
     truth_bvh = read_bvh(ROOT / "example_blends" / "walk_3view" / "truth.bvh")
@@ -171,7 +169,7 @@ def main(argv=None) -> int:
           f"{np.mean([got.limb_deg[k] for k in legs]):.1f} deg, all eight limbs "
           f"{got.limb_mean_deg:.1f} deg (first frame held still: {still.limb_mean_deg:.1f} deg)")
     print("per limb (deg): " + ", ".join(f"{k} {v:.1f}" for k, v in got.limb_deg.items()))
-    return plate_demo(bpy, bridge, a.out)
+    return plate_demo(bpy, twist_addon, a.out)
 
 
 if __name__ == "__main__":

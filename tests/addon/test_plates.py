@@ -62,8 +62,7 @@ def test_the_baboons_plate_is_cut_posed_and_tracked_in_blender(bpy_module, regis
         carried = R_first.copy()
         carried[0] = R[0]  # the first pose carried along with the body
         still = registered.core.pose.BodyPose(carried, root, [view])
-        scores.append((plates.overlap(plates.outline(bridged, pose, sil.shape), sil),
-                       plates.overlap(plates.outline(bridged, still, sil.shape), sil)))
+        scores.append((plates.overlap(bridged, pose, sil), plates.overlap(bridged, still, sil)))
     tracked, carried = np.array(scores[1:8]).T
     assert scores[0][0] > 0.5  # the clicked pose lines up
     assert tracked.mean() > carried.mean() + 0.02
