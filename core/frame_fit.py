@@ -153,8 +153,8 @@ class FrameFit:
         self.dof_thickness = thin[self._dof_joint]
         self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
                          and np.any(np.isfinite(skeleton.limits[j]))]
-        self._search = LimbSearch(skeleton, self.settings.limb_search)
         self._limbs = Limbs(skeleton, self._blobs)
+        self._search = LimbSearch(skeleton, self.settings.limb_search, self._limbs)
 
     def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:

@@ -29,6 +29,7 @@ import numpy as np
 
 from . import se3
 from .camera import View
+from .confidence import Limbs
 from .linearize import Kinematics
 from .pose import BodyPose
 from .raycast import BlobStack, blob_frames, shadows
@@ -120,20 +121,21 @@ def span_sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
 class LimbSearch:
     """Searches the limbs of ``skeleton`` against per-view foregrounds on one level."""
 
-    def __init__(self, skeleton: Skeleton, margin: float):
+    def __init__(self, skeleton: Skeleton, margin: float, limbs: Limbs | None = None):
+        """``limbs``: the skeleton's ``core.confidence.Limbs`` (made here if not given),
+        whose blobs each limb's outline is scored by."""
         self.sk = skeleton
         self.margin = margin
         moved = skeleton.moved_by()  # [m, j]: j moves m
         self.blobs = BlobStack.of(skeleton.blobs)
-        blob_joint = self.blobs.joint
-        tracked = [j for j in range(1, skeleton.n_joints) if skeleton.kinds[j] in (BALL, HINGE)]
+        limbs = limbs or Limbs(skeleton, self.blobs)
         self.limbs: list[_Limb] = []
-        for j in tracked:
-            below = moved[blob_joint, j]
-            inner = [k for k in tracked if k != j and moved[k, j]]
-            own = below & ~np.any(moved[blob_joint][:, inner], axis=1)
-            if not own.any():
-                continue
+        for i, name in enumerate(limbs.names):
+            j = skeleton.index(name)
+            if j == 0:
+                continue  # the root moves with the body's own pose, not as a limb
+            own = limbs.of_blob == i
+            below = moved[self.blobs.joint, j]
             frame = skeleton.bone_frame(j)
             if skeleton.kinds[j] == BALL:
                 dofs = [(j, frame[1], SWING), (j, frame[2], SWING)]
