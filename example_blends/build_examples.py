@@ -98,17 +98,11 @@ def build_plates(bpy, name: str, template: str, ortho_scale: float, location: tu
     return path
 
 
-def build_plate(bpy, twist_addon, name: str) -> Path:
-    """A printed plate cut into a view, with the planar quadruped clicked on its first frame
-    (see the module's docstring)."""
-    import json
-
-    spec = json.loads((PLATE_CLICKS / f"{name}.json").read_text())
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    path = HERE / f"muybridge_{name}.blend"
-    bpy.ops.wm.save_as_mainfile(filepath=str(path))
-    bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
-    scene = bpy.context.scene
+def pose_on_plate(scene, twist_addon, spec: dict, name: str):
+    """Over a scene whose one view is a plate's frames (``Add View from Plate``), the planar
+    quadruped of ``spec`` (``bench/plates.py``) standing on the joints clicked on its first
+    frame, the clicks as the view's markers there, the camera at ``PLATE_UNIT`` metres per
+    pixel; returns the armature."""
     view = scene.twist.views[0]
     W, H = scene.render.resolution_x, scene.render.resolution_y
     cam = view.camera  # looking along +y, x right, z up: pixel (x, y) at (x, -y) / unit
@@ -121,7 +115,23 @@ def build_plate(bpy, twist_addon, name: str) -> Path:
     scene.twist.tracker.side_on = True
     for bone, xy in spec["clicks"].items():
         twist_addon.markers.set_marker(view, bone, 1, *xy)
+    return arm
+
+
+def build_plate(bpy, twist_addon, name: str) -> Path:
+    """A printed plate cut into a view, with the planar quadruped clicked on its first frame
+    (see the module's docstring)."""
+    import json
+
+    spec = json.loads((PLATE_CLICKS / f"{name}.json").read_text())
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    path = HERE / f"muybridge_{name}.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
+    scene = bpy.context.scene
+    pose_on_plate(scene, twist_addon, spec, name)
     scene.render.fps = 15
+    cam = scene.twist.views[0].camera
     scene.camera = cam
     scene.frame_set(1)
     bpy.ops.wm.save_as_mainfile(filepath=str(path), relative_remap=True)

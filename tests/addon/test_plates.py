@@ -9,11 +9,10 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "bench"))
+sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "example_blends")]
 
 import plates  # noqa: E402
-
-UNIT = 0.01  # metres per pixel: the baboon about 0.7 m tall
+from build_examples import pose_on_plate  # noqa: E402
 
 
 def test_the_baboons_plate_is_cut_posed_and_tracked_in_blender(bpy_module, registered,
@@ -32,17 +31,10 @@ def test_the_baboons_plate_is_cut_posed_and_tracked_in_blender(bpy_module, regis
     assert bpy.ops.twist.add_plate_view(filepath=str(plate), first_frame=1) == {"FINISHED"}
     scene = bpy.context.scene
     assert (scene.frame_start, scene.frame_end) == (1, 12)
-    W, H = scene.render.resolution_x, scene.render.resolution_y
-    assert (W, H) == (129, 82)
-    cam = scene.twist.views[0].camera  # looking along +y, x right, z up: pixel = (x, -z) / UNIT
-    cam.data.ortho_scale = W * UNIT
-    cam.location = ((W - 1) / 2 * UNIT, -10.0, -(H - 1) / 2 * UNIT)
+    assert (scene.render.resolution_x, scene.render.resolution_y) == (129, 82)
     tw = registered.twist_addon
-    sk, first = plates.planar_body(spec, UNIT)
-    arm = tw.bridge.armature_from_skeleton(sk, "Baboon", scene.collection)
-    scene.twist.armature = arm
-    scene.twist.mode = "INDEPENDENT"
-    view = tw.bridge.view_from_camera(cam, scene)
+    arm = pose_on_plate(scene, tw, spec, "baboon")
+    view = tw.bridge.view_from_camera(scene.twist.views[0].camera, scene)
     bridged = tw.bridge.skeleton_from_armature(arm)
     R, root = tw.bridge.pose_from_armature(arm, bridged)
     np.testing.assert_allclose(view.project(bridged.world_positions(R, root)),
