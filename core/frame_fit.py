@@ -105,7 +105,7 @@ class _Samples:
     """One pose's look at the point sets on one level."""
 
     costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
-    parts: list  # per set: (indices of usable points, their q, image gradients, residuals)
+    parts: list  # per set: (indices of usable points, world points, image gradients, residuals)
     inside: np.ndarray  # (views,) fraction of each view's points inside its image
     sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
@@ -280,7 +280,8 @@ class FrameFit:
         """Unknowns solved on tracker level ``level``: the root always; a joint only where its
         blob is at least ``min_blob_pixels`` thick in the largest view's level, so that
         coarse levels do not fling thin limbs they cannot see."""
-        scale = max(v.pose.s for v in pose.views) / 2**level
+        root = pose.root_position
+        scale = max(v.scale_at(root) for v in pose.views) / 2**level
         nr = self.n_params - self.n_dof
         return np.concatenate([np.ones(nr, bool),
                                self.dof_thickness * scale >= self.settings.min_blob_pixels])
@@ -356,9 +357,8 @@ class FrameFit:
                                     mm.target * full, mm.weight))
         measured = []
         for k, ps in enumerate(sets):
-            view = est.views[ps.view]
-            q = view.scaled(kin.world_points(ps.seg_joint, ps.ref))
-            pix = q[:, :2] + view.center
+            world = kin.world_points(ps.seg_joint, ps.ref)
+            pix = est.views[ps.view].project(world)
             vals, inside = imagelib.sample(levels[ps.view], pix)
             if sigmas is None:
                 measured.append(self._sigmas(ps, vals[:, 0] - ps.value, inside))
@@ -376,7 +376,7 @@ class FrameFit:
             c = np.full(len(pix), np.nan)
             c[ok] = ps.weight[ok] * mixture_cost(r, sigma[ok], s.outlier_density)
             costs.append(c)
-            parts.append((ok, q[ok], vals[ok, 1:3], r))
+            parts.append((ok, world[ok], vals[ok, 1:3], r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         measured if sigmas is None else sigmas, shape_cost, shape_parts)
 
@@ -391,10 +391,10 @@ class FrameFit:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
         and the silhouette's rows (each mismatched pixel's two coordinates); one block of
         rows per view."""
-        pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, q, grad, r, w)
-        for ps, sigma, (ok, q, grad, r) in zip(sets, sigmas, smp.parts):
+        pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, X, grad, r, w)
+        for ps, sigma, (ok, world, grad, r) in zip(sets, sigmas, smp.parts):
             if len(ok):
-                pieces[ps.view].append((ps.seg_joint[ok], q, grad, r,
+                pieces[ps.view].append((ps.seg_joint[ok], world, grad, r,
                                         self._pixel_weights(ps, ok, r, sigma)))
         s = self.settings
         for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
@@ -405,19 +405,17 @@ class FrameFit:
             every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
             joints, world, target = joints[::every], world[::every], target[::every]
             pair_w = pair_w[::every]
-            view = kin.pose.views[c]
-            q = view.scaled(world)
-            n = len(q)
+            n = len(world)
             unit = np.zeros((2 * n, 2))  # x rows, then y rows
             unit[:n, 0] = unit[n:, 1] = 1.0
-            r = (q[:, :2] + view.center - target).T.ravel()
+            r = (kin.pose.views[c].project(world) - target).T.ravel()
             w = np.tile(pair_w, 2) * (s.silhouette * every / g**2)
-            pieces[c].append((np.tile(joints, 2), np.tile(q, (2, 1)), unit, r, w))
+            pieces[c].append((np.tile(joints, 2), np.tile(world, (2, 1)), unit, r, w))
         ne = NormalEquations.zeros(self.n_params)
         for c, view_pieces in enumerate(pieces):
             if view_pieces:
-                joints, q, grad, r, w = (np.concatenate(x) for x in zip(*view_pieces))
-                ne.add(rows(kin, c, self.mode, joints, q, grad), r, w)
+                joints, world, grad, r, w = (np.concatenate(x) for x in zip(*view_pieces))
+                ne.add(rows(kin, c, self.mode, joints, world, grad), r, w)
         return ne
 
     def _sigmas(self, ps: PointSet, r: np.ndarray, inside: np.ndarray) -> np.ndarray:
@@ -497,7 +495,7 @@ class FrameFit:
                      ) -> list[tuple]:
         """The body's pixels of ``prev_frame`` (at pose ``prev``, full resolution, every
         ``pixel_step``-th) mapped into ``frame`` under ``est``, those visible there: per view
-        (view, segment joints (N,), scaled camera points q (N, 3), image gradients (N, 2),
+        (view, segment joints (N,), world points (N, 3), image gradients (N, 2),
         brightness residuals (N,), EM support weights (N,)). For estimates made outside the
         tracker's own system (the skeleton's refinement)."""
         self.scale_to(prev)
@@ -507,9 +505,9 @@ class FrameFit:
                 for c in range(self.seq.n_views)]
         smp = self.sample(est, kin, sets, levels, 0)
         out = []
-        for ps, sigma, (ok, q, grad, r) in zip(sets, smp.sigmas, smp.parts):
+        for ps, sigma, (ok, world, grad, r) in zip(sets, smp.sigmas, smp.parts):
             w = self._pixel_weights(ps, ok, r, sigma)
-            out.append((ps.view, ps.seg_joint[ok], q, grad, r, w))
+            out.append((ps.view, ps.seg_joint[ok], world, grad, r, w))
         return out
 
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,

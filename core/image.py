@@ -42,6 +42,7 @@ def check_footage(paths, where: str) -> None:
     must not stop a run half way, and frames of one view are one camera's (cells cropped
     each its own way are not). The decoder's own complaints are kept off the terminal."""
     size = first = None
+    paths = getattr(paths, "source", paths)  # footage read undistorted: its files
     with quiet_stderr():
         for p in (p for p in paths if isinstance(p, (str, Path))):
             img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)

@@ -18,10 +18,11 @@ import numpy as np
 
 from . import se3
 from .bvh import BvhError, BvhFile, read_bvh
-from .camera import View
+from .camera import Camera, Pinhole, View
 from .errors import InputError
 from .image import ImageError
 from .init_fit import FitError, clicked_point
+from .lens import Undistorted, undistort_points
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, pose_from_bvh
 from .settings import TrackerSettings
 from .skeleton import BALL, FIXED, HINGE, Skeleton, skeleton_from_bvh
@@ -38,7 +39,7 @@ class Job:
     bvh: BvhFile  # the skeleton's BVH: hierarchy and channel layout of the output
     initial: BodyPose
     images: list  # per view, per frame: image paths, or a movie's VideoFrames
-    cameras: list[View]  # the cameras as given (the initial pose's views start as copies)
+    cameras: list[Camera]  # the cameras as given (the initial pose's views start as copies)
     mode: str
     settings: TrackerSettings
     frame_time: float
@@ -65,12 +66,7 @@ def _vector(v, n: int, where: str) -> np.ndarray:
     return a
 
 
-def parse_camera(d, where: str) -> View:
-    if not isinstance(d, dict):
-        raise JobError(f"{where}: expected an object with model, R, t, scale, center")
-    model = _field(d, "model", where, str)
-    if model != "scaled_orthographic":
-        raise JobError(f"{where}.model: only 'scaled_orthographic' is supported, got '{model}'")
+def _rotation(d: dict, where: str) -> np.ndarray:
     try:
         R = np.asarray(_field(d, "R", where), dtype=float)
     except (TypeError, ValueError):
@@ -79,12 +75,60 @@ def parse_camera(d, where: str) -> View:
         R
     ) < 0:
         raise JobError(f"{where}.R: expected a 3x3 rotation matrix (orthonormal, det +1)")
+    return R
+
+
+def _intrinsics(d: dict, where: str) -> np.ndarray:
+    try:
+        K = np.asarray(_field(d, "K", where), dtype=float)
+    except (TypeError, ValueError):
+        raise JobError(f"{where}.K: expected a 3x3 matrix [[fx, 0, cx], [0, fy, cy], "
+                       "[0, 0, 1]]") from None
+    if K.shape != (3, 3) or not np.all(np.isfinite(K)):
+        raise JobError(f"{where}.K: expected a 3x3 matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]")
+    if K[1, 0] != 0 or K[2, 0] != 0 or K[2, 1] != 0 or K[2, 2] != 1:
+        raise JobError(f"{where}.K: expected an upper triangular matrix with last row "
+                       f"[0, 0, 1], got {K.tolist()}")
+    if not (K[0, 0] > 0 and K[1, 1] > 0):
+        raise JobError(f"{where}.K: the focal lengths fx = {K[0, 0]:g}, fy = {K[1, 1]:g} "
+                       "(pixels) must be > 0")
+    return K
+
+
+def parse_camera(d, where: str) -> tuple[Camera, np.ndarray | None]:
+    """A view's camera and its lens distortion (OpenCV's k1, k2, p1, p2[, k3[, ...]]; None:
+    none): ``scaled_orthographic`` (R, t, scale, center) or ``pinhole`` (K, R, t, and
+    optionally dist)."""
+    if not isinstance(d, dict):
+        raise JobError(f"{where}: expected an object with model and the model's fields")
+    model = _field(d, "model", where, str)
+    if model == "pinhole":
+        K, R = _intrinsics(d, where), _rotation(d, where)
+        t = _vector(_field(d, "t", where), 3, f"{where}.t")
+        dist = None
+        if d.get("dist") is not None:
+            try:
+                dist = np.asarray(d["dist"], dtype=float)
+            except (TypeError, ValueError):
+                dist = np.zeros(0)
+            if dist.ndim != 1 or len(dist) not in (4, 5, 8, 12, 14) or not np.all(
+                    np.isfinite(dist)):
+                raise JobError(f"{where}.dist: expected OpenCV's distortion coefficients "
+                               f"[k1, k2, p1, p2, k3] (4, 5, 8, 12 or 14 numbers), got "
+                               f"{d['dist']!r}")
+            if not np.any(dist):
+                dist = None
+        return Pinhole(K, R, t), dist
+    if model != "scaled_orthographic":
+        raise JobError(f"{where}.model: expected 'pinhole' or 'scaled_orthographic', got "
+                       f"'{model}'")
+    R = _rotation(d, where)
     t = _vector(_field(d, "t", where), 3, f"{where}.t")
     scale = _field(d, "scale", where, (int, float))
     if not scale > 0:
         raise JobError(f"{where}.scale: expected pixels per world unit > 0, got {scale}")
     center = _vector(_field(d, "center", where), 2, f"{where}.center")
-    return View(se3.Similarity(scale, R, t), center)
+    return View(se3.Similarity(scale, R, t), center), None
 
 
 def _images(spec, base: Path, where: str):
@@ -252,7 +296,7 @@ def _bvh_pose(spec: dict, bvh: BvhFile, bvh_path: Path, base: Path, where: str
 
 
 def _corrections(spec, sk: Skeleton, bvh: BvhFile, bvh_path: Path, base: Path,
-                 cameras: list[View], n_frames: int, where: str) -> dict[int, BodyPose]:
+                 cameras: list[Camera], n_frames: int, where: str) -> dict[int, BodyPose]:
     """The ``corrections`` field: footage frame -> the pose the user gives there."""
     if not isinstance(spec, list):
         raise JobError(f"{where}: expected a list of {{image, bvh, frame}}")
@@ -272,21 +316,41 @@ def _corrections(spec, sk: Skeleton, bvh: BvhFile, bvh_path: Path, base: Path,
     return out
 
 
-def _views(d: dict, where: str) -> tuple[list[dict], list[View]]:
-    """The ``views`` field (at least one) and each view's camera."""
+def _views(d: dict, where: str) -> tuple[list[dict], list[Camera], list]:
+    """The ``views`` field (at least one), each view's camera and its lens distortion."""
     views = _field(d, "views", where, list)
     if not views:
         raise JobError(f"{where}.views: expected at least one view")
-    cameras = [parse_camera(_field(v, "camera", f"{where}.views[{i}]"),
-                            f"{where}.views[{i}].camera") for i, v in enumerate(views)]
-    return views, cameras
+    parsed = [parse_camera(_field(v, "camera", f"{where}.views[{i}]"),
+                           f"{where}.views[{i}].camera") for i, v in enumerate(views)]
+    return views, [c for c, _ in parsed], [dist for _, dist in parsed]
 
 
-def _mode(d: dict, where: str) -> str:
-    mode = d.get("mode", INDEPENDENT)
+def _mode(d: dict, cameras: list[Camera], where: str) -> str:
+    """The ``mode`` field: 'calibrated' by default with pinhole cameras (and only then),
+    'independent' otherwise."""
+    pinhole = [i for i, c in enumerate(cameras) if c.central]
+    mode = d.get("mode", CALIBRATED if pinhole else INDEPENDENT)
     if mode not in (CALIBRATED, INDEPENDENT):
         raise JobError(f"{where}.mode: expected 'calibrated' or 'independent', got {mode!r}")
+    if pinhole and mode != CALIBRATED:
+        raise JobError(f"{where}.mode: view {pinhole[0] + 1}'s camera is a pinhole, whose "
+                       "pose is its calibration's: the mode must be 'calibrated'")
     return mode
+
+
+def _in_front(pose: BodyPose, sk: Skeleton, where: str) -> None:
+    """Every joint of ``pose`` in front of every pinhole camera (a JobError naming the view
+    and a joint behind it)."""
+    X = sk.world_positions(pose.rotations, pose.root_position)
+    for i, cam in enumerate(pose.views):
+        if cam.central:
+            z = cam.camera_points(X)[:, 2]
+            if np.any(z <= 0):
+                j = int(np.argmin(z))
+                raise JobError(f"{where}: the joint '{sk.names[j]}' lies behind view {i + 1}'s "
+                               f"camera (depth {z[j]:.3g}): check the camera's R and t "
+                               "(x_cam = R X + t, z forward) and the pose's units")
 
 
 def load_job(path: str | Path) -> Job:
@@ -295,21 +359,24 @@ def load_job(path: str | Path) -> Job:
     d = _read_json(path, "job file")
     base, where = path.parent, path.name
     sk, bvh, bvh_path, init_bvh, frame = _body(d, base, where)
-    views, cameras = _views(d, where)
+    views, cameras, dists = _views(d, where)
     images = [_images(_field(v, "images", f"{where}.views[{i}]"), base,
                       f"{where}.views[{i}].images") for i, v in enumerate(views)]
+    images = [x if dist is None else Undistorted(x, cam.K, dist)
+              for x, cam, dist in zip(images, cameras, dists)]
     counts = {len(x) for x in images}
     if len(counts) > 1:
         raise JobError(f"{where}.views: every view needs the same number of frames, got "
                        + ", ".join(str(len(x)) for x in images))
     if min(counts) < 2:
         raise JobError(f"{where}.views: at least two frames are needed to track")
-    mode = _mode(d, where)
+    mode = _mode(d, cameras, where)
     settings = _settings(d.get("settings"), f"{where}.settings")
     ft = d.get("frame_time", bvh.frame_time)
     if not isinstance(ft, (int, float)) or ft <= 0:
         raise JobError(f"{where}.frame_time: expected seconds per frame > 0, got {ft!r}")
     pose = pose_from_bvh(init_bvh, frame, cameras)
+    _in_front(pose, sk, f"{where}.initial")
     corrections = _corrections(d.get("corrections", []), sk, bvh, bvh_path, base, cameras,
                                len(images[0]), f"{where}.corrections")
     return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections)
@@ -323,7 +390,7 @@ class FitJob:
     skeleton: Skeleton
     bvh: BvhFile
     guess: BodyPose
-    cameras: list[View]
+    cameras: list[Camera]
     clicks: list[dict[str, np.ndarray]]
     mode: str
     fit_lengths: bool = True  # also fit the bone lengths (needs two views or more)
@@ -337,7 +404,7 @@ def load_fit(path: str | Path) -> FitJob:
     d = _read_json(path, "fit file")
     base, where = path.parent, path.name
     sk, bvh, _, init_bvh, frame = _body(d, base, where)
-    views, cameras = _views(d, where)
+    views, cameras, dists = _views(d, where)
     clicks_in = _field(d, "clicks", where, list)
     if len(clicks_in) != len(views):
         raise JobError(f"{where}.clicks: expected one object per view ({len(views)}), got "
@@ -352,7 +419,12 @@ def load_fit(path: str | Path) -> FitJob:
                 clicked_point(sk, name)
             except FitError as e:
                 raise JobError(f"{w}.{name}: {e}") from None
-        clicks.append({name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()})
+        at = {name: _vector(p, 2, f"{w}.{name}") for name, p in c.items()}
+        if dists[i] is not None and at:  # clicked on the footage as filmed
+            ideal = undistort_points(np.array(list(at.values())), cameras[i].K, dists[i])
+            at = dict(zip(at, ideal))
+        clicks.append(at)
     fit_lengths = _field(d, "fit_lengths", where, bool) if "fit_lengths" in d else True
-    return FitJob(sk, bvh, pose_from_bvh(init_bvh, frame, cameras), cameras, clicks,
-                  _mode(d, where), fit_lengths)
+    guess = pose_from_bvh(init_bvh, frame, cameras)
+    _in_front(guess, sk, f"{where}.initial")
+    return FitJob(sk, bvh, guess, cameras, clicks, _mode(d, cameras, where), fit_lengths)

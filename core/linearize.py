@@ -1,15 +1,19 @@
 """The per-pixel rows [H | J] of the linear motion model, one view at a time.
 
-A body point at scaled camera coordinate q = (x, y, z) with image gradient g = (Ix, Iy, 0)
-gives one brightness-constancy row A_i with  I_t + A_i . delta = 0  (paper eqs. 18, 28, 33).
+A body point X (world) with image gradient g = (Ix, Iy) at its pixel gives one
+brightness-constancy row A_i with  I_t + A_i . delta = 0  (paper eqs. 18, 28, 33). The camera
+carries g back to the world through its projection's Jacobian: m = J^T g (``pullback``), so
+that a world displacement dX of the point changes the brightness by m . dX. Then:
 
-* Independent mode, this view's root block (about the root's image point q_r, d = q - q_r):
-  [g.d, Ix, Iy, (d x g)]  -- paper eq. 18 with the pivot moved to q_r.
-* Calibrated mode, the shared world root (about the root's world position c, c' its scaled
-  camera point, camera rotation R, scale s):  [s R^T g, R^T((q - c') x g)].
-* One column per joint degree of freedom, with its axis w' and a point o' on it carried into
-  scaled camera coordinates and v' = o' x w' (eq. 26):  g . v' + w' . (q x g), zero on pixels
-  whose segment that joint does not move (eq. 30).
+* Calibrated mode, the shared world root (a translation and a rotation about the root's world
+  position c):  [m, (X - c) x m].
+* Independent mode (scaled orthographic views only), this view's root block about the root's
+  image point q_r, with q the point's scaled camera coordinate and d = q - q_r:
+  [g.d, Ix, Iy, (d x g)] with g = (Ix, Iy, 0)  -- paper eq. 18 with the pivot moved to q_r.
+* One column per joint degree of freedom, a turn about the world axis a through the point o:
+  m . (a x (X - o)) = a . ((X - c) x m) - m . (a x (o - c)) (paper eq. 26 carried to the
+  world), zero on
+  pixels whose segment that joint does not move (eq. 30).
 
 Everything is vectorised over pixels; the joint block is two (N, 3) x (3, D) products.
 """
@@ -18,7 +22,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .camera import View
 from .pose import CALIBRATED, ROOT_PARAMS, BodyPose, n_root_params
 from .skeleton import Skeleton
 
@@ -61,32 +64,31 @@ def rows(
     view_index: int,
     mode: str,
     seg_joint: np.ndarray,
-    q: np.ndarray,
+    X: np.ndarray,
     grad: np.ndarray,
 ) -> np.ndarray:
-    """Rows (N, P) of one view for points on segments ``seg_joint`` (N,) at scaled camera
-    coordinates q (N, 3) with image gradients ``grad`` (N, 2) per full-resolution pixel."""
-    view: View = kin.pose.views[view_index]
+    """Rows (N, P) of one view for points on segments ``seg_joint`` (N,) at world positions
+    X (N, 3) with image gradients ``grad`` (N, 2) per full-resolution pixel."""
+    view = kin.pose.views[view_index]
     n_views = len(kin.pose.views)
     nr = n_root_params(mode, n_views)
     D = len(kin.dof_joint)
-    N = len(q)
+    N = len(X)
     A = np.zeros((N, nr + D))
-    d = q - view.scaled(kin.frames[0, :3, 3])  # from the root, scaled camera frame
-    dxg = _cross_g(d, grad)
+    m = view.pullback(X, grad)
+    c = kin.frames[0, :3, 3]  # the root: lever arms from it keep the products small
+    xm = _cross(X - c, m)
     if mode == CALIBRATED:
-        R = view.pose.R
-        A[:, 0:3] = view.pose.s * grad @ R[:2]
-        A[:, 3:6] = dxg @ R
+        A[:, 0:3] = m
+        A[:, 3:6] = xm
     else:
         o = ROOT_PARAMS * view_index
+        d = view.scaled(X) - view.scaled(c)  # from the root's image point
         A[:, o] = grad[:, 0] * d[:, 0] + grad[:, 1] * d[:, 1]
         A[:, o + 1 : o + 3] = grad
-        A[:, o + 3 : o + 6] = dxg
+        A[:, o + 3 : o + 6] = _cross_g(d, grad)
     if D:
-        w_cam = kin.dof_axis_world @ view.pose.R.T  # (D, 3)
-        o_cam = view.scaled(kin.dof_point_world)  # (D, 3)
-        v_cam = _cross(o_cam, w_cam)
-        J = grad @ v_cam[:, :2].T + _cross_g(q, grad) @ w_cam.T
+        a = kin.dof_axis_world
+        J = xm @ a.T - m @ _cross(a, kin.dof_point_world - c).T
         A[:, nr:] = J * kin.moves[seg_joint]
     return A

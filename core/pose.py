@@ -1,16 +1,17 @@
 """The tracked state of one frame, its parameter layout and its update.
 
 A ``BodyPose`` holds the local rotations of every joint, the root's world position and one
-``View`` per camera. Two modes share it:
+camera per view (``core.camera``). Two modes share it:
 
 * ``calibrated``: the cameras are known and fixed; the unknowns are the root's world motion,
   6 numbers (dvx, dvy, dvz, dwx, dwy, dwz): a world translation and a world rotation vector
   about the root joint's current position.
-* ``independent`` (the paper's): each view carries its own scaled pose of the body; the root
-  stays at its initial world pose and each view's camera moves instead. Per view 6 numbers
-  (ds, dv1, dv2, dwx, dwy, dwz), a similarity acting on the left in scaled camera coordinates
-  about the root's image point q_r:  q -> q_r + (1 + ds) e^{[dw]} (q - q_r) + (dv1, dv2, 0)
-  (paper eqs. 13-15; depth translation is invisible and not a parameter).
+* ``independent`` (the paper's, scaled orthographic views only): each view carries its own
+  scaled pose of the body; the root stays at its initial world pose and each view's camera
+  moves instead. Per view 6 numbers (ds, dv1, dv2, dwx, dwy, dwz), a similarity acting on
+  the left in scaled camera coordinates about the root's image point q_r:
+  q -> q_r + (1 + ds) e^{[dw]} (q - q_r) + (dv1, dv2, 0) (paper eqs. 13-15; depth
+  translation is invisible and not a parameter).
 
 Joint degrees of freedom follow, in the skeleton's ``dof_joints_and_axes`` order:
 R_j <- R_j e^{d [a]} for the axis a of the degree of freedom in joint j's local frame.
@@ -24,7 +25,7 @@ import numpy as np
 
 from . import se3
 from .bvh import BvhFile
-from .camera import View
+from .camera import Camera, View
 from .skeleton import Skeleton
 
 CALIBRATED, INDEPENDENT = "calibrated", "independent"
@@ -35,7 +36,7 @@ ROOT_PARAMS = 6
 class BodyPose:
     rotations: np.ndarray  # (J, 3, 3) local rotations; rotations[0] is the root's world rotation
     root_position: np.ndarray  # (3,) world position of the root joint
-    views: list[View]
+    views: list[Camera]
 
     def copy(self) -> BodyPose:
         return BodyPose(
@@ -43,7 +44,7 @@ class BodyPose:
         )
 
 
-def pose_from_bvh(bvh: BvhFile, frame: int, cameras: list[View]) -> BodyPose:
+def pose_from_bvh(bvh: BvhFile, frame: int, cameras: list[Camera]) -> BodyPose:
     """The pose of a BVH file's frame (0-based), seen through copies of ``cameras``."""
     R, root = bvh.frame_pose(frame)
     return BodyPose(R, root, [c.copy() for c in cameras])
@@ -88,18 +89,7 @@ def extrapolate(prev: BodyPose, cur: BodyPose, gain: float = 1.0) -> BodyPose:
         step = se3.log_so3(prev.rotations[j].T @ cur.rotations[j])
         out.rotations[j] = cur.rotations[j] @ se3.exp_so3(gain * step)
     out.root_position = cur.root_position + gain * (cur.root_position - prev.root_position)
-    for c, (vp, vc) in enumerate(zip(prev.views, cur.views)):
-        Mp, Mc = vp.pose.matrix(), vc.pose.matrix()
-        step = Mc @ np.linalg.inv(Mp)  # similarity taking the previous camera to the current
-        sR = step[:3, :3]
-        s = np.cbrt(np.linalg.det(sR))
-        w = se3.log_so3(sR / s)
-        st = np.eye(4)
-        st[:3, :3] = s**gain * se3.exp_so3(gain * w)
-        st[:3, 3] = gain * step[:3, 3]
-        M = st @ Mc
-        sn = np.cbrt(np.linalg.det(M[:3, :3]))
-        out.views[c] = View(se3.Similarity(sn, M[:3, :3] / sn, M[:3, 3] / sn), vc.center.copy())
+    out.views = [vc.extrapolated(vp, gain) for vp, vc in zip(prev.views, cur.views)]
     return out
 
 

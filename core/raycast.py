@@ -1,10 +1,12 @@
-"""Which blob is in front at each pixel, and where: orthographic ray against every ellipsoid.
+"""Which blob is in front at each pixel, and where: each pixel's ray against every ellipsoid.
 
-A pixel's world ray X(l) = o + l d (d away from the camera) meets ellipsoid e, written in
-its own normalised frame y = diag(1/r) Q^T (g_e^{-1} X - c), where |y0 + l e|^2 = 1. The nearest
-root over all blobs is the visible surface (paper eq. 17, one quadratic per blob); the pixel
-belongs to that blob's segment. Under orthography the direction e is the same for every pixel,
-so all pixels and blobs are two array operations.
+A pixel's world ray X(l) = o + l d meets ellipsoid e, written in its own normalised frame
+y = diag(1/r) Q^T (g_e^{-1} X - c), where |w + l e|^2 = 1 with w and e the ray's start and
+direction in that frame. The nearest root over all blobs is the visible surface (paper eq. 17,
+one quadratic per blob); the pixel belongs to that blob's segment. Under orthography e is the
+same for every pixel and w is affine in the pixel; through a pinhole w is the same (the
+camera's centre) and e is affine: in both, the quadratic's coefficients are polynomials in the
+pixel, so whole grids of pixels are a few array operations (``render_labels``).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .camera import View
+from .camera import Camera
 from .skeleton import Ellipsoid
 
 
@@ -78,46 +80,47 @@ def _to_unit(blobs: BlobStack, R: np.ndarray) -> np.ndarray:
     return np.einsum("eba,ecb->eac", blobs.to_unit, R)  # (Q diag(1 / r))^T R^T
 
 
-def cast(view: View, pixels: np.ndarray, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray
+def cast(view: Camera, pixels: np.ndarray, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray
          ) -> Hits:
-    """Nearest blob hit for each pixel (N, 2) in the view, blobs posed by segment motions g."""
+    """Nearest blob hit for each pixel (N, 2) in the view, blobs posed by segment motions g;
+    depths are distances along the rays (``Camera.ray``)."""
     origin, d = view.ray(pixels)
     N = len(pixels)
     if not len(blobs):
         return Hits(np.full(N, -1), np.full(N, np.inf), np.zeros((N, 3)), np.zeros(N))
     A, C = blob_frames(blobs, g)
-    e = A @ d  # (E, 3)
-    E = len(blobs)
-    y0 = (origin @ A.reshape(E * 3, 3).T - np.einsum("eab,eb->ea", A, C).ravel()).reshape(N, E, 3)
-    a = np.sum(e * e, -1)  # (E,)
-    b = np.einsum("nea,ea->ne", y0, e)
+    e = np.einsum("eab,nb->nea", A, d)  # (N, E, 3)
+    y0 = np.einsum("eab,neb->nea", A, origin[:, None, :] - C[None])
+    a = np.sum(e * e, -1)  # (N, E)
+    b = np.sum(y0 * e, -1)
     c = np.sum(y0 * y0, -1) - 1
     disc = b * b - a * c
-    hit = disc > 0
-    lam = np.where(hit, (-b - np.sqrt(np.where(hit, disc, 0))) / a, np.inf)
+    lam = (-b - np.sqrt(np.maximum(disc, 0))) / a
+    # a pinhole sees what is in front of it; a parallel ray's start is an arbitrary plane
+    lam = np.where((disc > 0) & ((lam > 0) | (not view.central)), lam, np.inf)
     label = np.argmin(lam, axis=1)
-    depth = lam[np.arange(N), label]
+    rows = np.arange(N)
+    depth = lam[rows, label]
     ok = np.isfinite(depth)
     label = np.where(ok, label, -1)
     world = origin + np.where(ok, depth, 0)[:, None] * d
-    rim = np.where(ok, disc[np.arange(N), np.maximum(label, 0)] / a[np.maximum(label, 0)], 0.0)
+    rim = np.where(ok, disc[rows, label] / a[rows, label], 0.0)
     return Hits(label, depth, world, np.clip(rim, 0.0, 1.0))
 
 
-def blob_boxes(view: View, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray) -> np.ndarray:
-    """Pixel extents (E, 4) = (xmin, ymin, xmax, ymax) of every blob's outline, as floats.
-
-    An ellipsoid's half extent along image axis i is |row i of s R_cam R_seg Q diag(r)|."""
+def blob_boxes(view: Camera, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray) -> np.ndarray:
+    """Pixel extents (E, 4) = (xmin, ymin, xmax, ymax) of every blob's outline, as floats."""
     blobs = BlobStack.of(blobs)
-    return _boxes(view, blobs, *_posed(blobs, g))
+    Rs, C = _posed(blobs, g)
+    return _boxes(view, _to_unit(blobs, Rs), C)
 
 
-def _boxes(view: View, blobs: BlobStack, Rs: np.ndarray, centres: np.ndarray) -> np.ndarray:
-    """``blob_boxes`` of blobs posed by ``_posed``."""
-    axes = np.einsum("eab,ebc->eac", Rs, blobs.Q) * blobs.radii[:, None, :]
-    M = view.pose.s * np.einsum("ab,ebc->eac", view.pose.R[:2], axes)
-    half = np.linalg.norm(M, axis=2)
-    c = view.project(centres)
+def _boxes(view: Camera, A: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """``blob_boxes`` of blobs with world-to-normalised maps A and world centres C: the
+    outline (p - c)^T P (p - c) <= 1 reaches sqrt of P^-1's diagonal from its centre."""
+    c, P = view.ellipses(A, C)
+    det = P[:, 0, 0] * P[:, 1, 1] - P[:, 0, 1] * P[:, 1, 0]
+    half = np.sqrt(np.stack([P[:, 1, 1], P[:, 0, 0]], 1) / det[:, None])
     return np.concatenate([c - half, c + half], 1)
 
 
@@ -128,17 +131,18 @@ def _clip_box(lo, hi, shape, margin: int):
     return None if x0 >= x1 or y0 >= y1 else (x0, y0, x1, y1)
 
 
-def render_labels(view: View, blobs: list[Ellipsoid] | BlobStack, g, shape, step: int = 1
+def render_labels(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, step: int = 1
                   ) -> tuple[np.ndarray, Hits, tuple]:
     """Z-buffer the pixels of the silhouette box whose coordinates are multiples of ``step``,
     over every blob's own box at once; returns the covered pixels (N, 2), their hits and
     the box (None if nothing shows).
 
-    Same result as :func:`cast` on those pixels, at a fraction of the work: under orthography
-    the ray's start is affine in the pixel, so each blob's quadratic is evaluated on its box."""
+    Same result as :func:`cast` on those pixels, at a fraction of the work: each blob's
+    quadratic's coefficients are polynomials in the pixel, evaluated on its box."""
     blobs = BlobStack.of(blobs)
     Rs, C = _posed(blobs, g)  # once, for the boxes and the blobs' normalised frames
-    boxes = _boxes(view, blobs, Rs, C) if len(blobs) else np.zeros((0, 4))
+    A = _to_unit(blobs, Rs)
+    boxes = _boxes(view, A, C) if len(blobs) else np.zeros((0, 4))
     box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if len(blobs) else None
     if box is None:
         empty = np.zeros((0, 2))
@@ -148,23 +152,29 @@ def render_labels(view: View, blobs: list[Ellipsoid] | BlobStack, g, shape, step
     xs = np.arange(x0, x1, step, dtype=float)
     ys = np.arange(y0, y1, step, dtype=float)
     depth = np.full((len(ys), len(xs)), np.inf)
-    A = _to_unit(blobs, Rs)
-    (o00,), d = view.ray(np.array([[0.0, 0.0]]))
-    ox = view.ray(np.array([[1.0, 0.0]]))[0][0] - o00  # world step of the ray start per pixel
-    oy = view.ray(np.array([[0.0, 1.0]]))[0][0] - o00
-    # w(u, v) = w0 + u wx + v wy in each blob's normalised frame, so b = w.e is affine and
-    # disc = b^2 - a (|w|^2 - 1) quadratic in the pixel: all coefficients per blob up front
-    e = A @ d  # (E, 3)
-    w0 = np.einsum("eab,eb->ea", A, o00 - C)
-    wx, wy = A @ ox, A @ oy
-    a = np.sum(e * e, 1)
-    b0, bx, by = (np.sum(w * e, 1) for w in (w0, wx, wy))
+    o0, ox, oy, r0, rx, ry = view.ray_lines()
+    # the ray in each blob's normalised frame: start w = w0 + u wx + v wy, direction
+    # e = e0 + u ex + v ey (one of the two is the same for every pixel)
+    w0 = np.einsum("eab,eb->ea", A, o0 - C)
+    wx, wy, e0, ex, ey = A @ ox, A @ oy, A @ r0, A @ rx, A @ ry
+    # |w + l e|^2 = 1 is a l^2 + 2 b l + c = 0 with a constant, b affine and c quadratic in
+    # (u, v). Under orthography (e fixed) a = |e|^2, b = w.e, c = |w|^2 - 1, and the nearer
+    # root is l. Through a pinhole (w fixed), in m = 1 / l: a = |w|^2 - 1, b = -w.e,
+    # c = |e|^2, and the nearer root is -m. Either way the root (-b - sqrt(b^2 - a c)) / a
+    # is a depth key, smaller nearer: in terms of the fixed vector f and the affine one
+    # p = p0 + u px + v py, a = |f|^2 - [pinhole], b = +-p.f, c = |p|^2 - [orthography]
+    if view.central:
+        f, (p0, px, py), sign = w0, (e0, ex, ey), -1.0
+    else:
+        f, (p0, px, py), sign = e0, (w0, wx, wy), 1.0
 
     def dot(p, q):
         return np.sum(p * q, 1)
 
-    c00, c0x, c0y = dot(w0, w0) - 1, dot(w0, wx), dot(w0, wy)
-    cxx, cxy, cyy = dot(wx, wx), dot(wx, wy), dot(wy, wy)
+    a = dot(f, f) - view.central
+    b0, bx, by = (sign * dot(p, f) for p in (p0, px, py))
+    c00, c0x, c0y = dot(p0, p0) - (not view.central), dot(p0, px), dot(p0, py)
+    cxx, cxy, cyy = dot(px, px), dot(px, py), dot(py, py)
     d00, dx, dy = b0 * b0 - a * c00, 2 * (b0 * bx - a * c0x), 2 * (b0 * by - a * c0y)
     dxx, dxy, dyy = bx * bx - a * cxx, 2 * (bx * by - a * cxy), by * by - a * cyy
     # each blob's grid columns and rows: its box widened by a pixel, clipped to the image
@@ -193,6 +203,9 @@ def render_labels(view: View, blobs: list[Ellipsoid] | BlobStack, g, shape, step
     hit = disc > 0
     r, c, at_r, at_c, disc, blob = r[hit], c[hit], at_r[hit], at_c[hit], disc[hit], blob[hit]
     lam = BV.take(at_r) + BU.take(at_c) - np.sqrt(disc)
+    if view.central:  # what lies behind the pinhole is not seen (m < 0)
+        ahead = lam < 0
+        r, c, blob, disc, lam = r[ahead], c[ahead], blob[ahead], disc[ahead], lam[ahead]
     # the z-buffer: per cell the nearest hit, the first blob on a tie
     cell = r * len(xs) + c
     flat_depth = depth.ravel()
@@ -207,20 +220,13 @@ def render_labels(view: View, blobs: list[Ellipsoid] | BlobStack, g, shape, step
     disc_front = disc_front.reshape(depth.shape)
     vv, uu = np.nonzero(label >= 0)
     pixels = np.stack([xs[uu], ys[vv]], 1)
-    dep = depth[vv, uu]
+    key = depth[vv, uu]
     lab = label[vv, uu]
-    origin = o00 + pixels[:, :1] * ox + pixels[:, 1:] * oy
-    hits = Hits(lab, dep, origin + dep[:, None] * d, np.minimum(disc_front[vv, uu] * a[lab], 1.0))
+    u, v = pixels[:, :1], pixels[:, 1:]
+    ray = r0 + u * rx + v * ry
+    lam = -1.0 / key if view.central else key  # along ``ray``
+    norm = np.linalg.norm(ray, axis=1)
+    e = e0[lab] + u * ex[lab] + v * ey[lab]
+    rim = disc_front[vv, uu] * a[lab] ** 2 / np.sum(e * e, 1)  # (b^2 - a c) / |e|^2
+    hits = Hits(lab, lam * norm, o0 + u * ox + v * oy + lam[:, None] * ray, np.minimum(rim, 1.0))
     return pixels, hits, box
-
-
-def shadows(view: View, A: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Outlines of ellipsoids under the view's orthographic projection: pixel p is covered by
-    ellipsoid e when (p - c_e)^T P_e (p - c_e) <= 1. Takes world-to-normalised maps A (..., 3, 3)
-    and world centres C (..., 3) (``blob_frames``); returns pixel centres c (..., 2) and the
-    2x2 forms P (..., 2, 2): the camera-frame quadratic with depth eliminated."""
-    R, s = view.pose.R, view.pose.s
-    AR = A @ R.T / s  # normalised coordinates per scaled-camera unit
-    M = np.swapaxes(AR, -1, -2) @ AR
-    P = M[..., :2, :2] - M[..., :2, 2:] * M[..., 2:, :2] / M[..., 2:, 2:]
-    return view.project(C), P

@@ -58,7 +58,7 @@ def segment_twists(tracker: Tracker, poses: Sequence[BodyPose], frames: Sequence
     parent = sk.parents[joint]
     basis = np.eye(6)
     if planar:  # translation along the image axes, rotation about the view direction
-        R = poses[0].views[0].pose.R
+        R = poses[0].views[0].orientation
         basis = np.zeros((6, 3))
         basis[:3, 0], basis[:3, 1], basis[3:, 2] = R[0], R[1], R[2]
     own = np.zeros(sk.n_joints, dtype=bool)  # the parent's own segment
@@ -82,10 +82,10 @@ def _free_twist(kin: Kinematics, pixels: list, segments: np.ndarray, basis: np.n
     """The rigid motion (6,) the pixels of ``segments`` ask for (one least-squares step, in
     the span of ``basis``), as a twist in ``joint``'s frame before its rotation."""
     ne = NormalEquations.zeros(basis.shape[1])
-    for view, seg, q, grad, r, w in pixels:
+    for view, seg, world, grad, r, w in pixels:
         keep = segments[seg]
         if keep.any():
-            A = rows(kin, view, CALIBRATED, seg[keep], q[keep], grad[keep])[:, :6]
+            A = rows(kin, view, CALIBRATED, seg[keep], world[keep], grad[keep])[:, :6]
             ne.add(A @ basis, r[keep], w[keep])
     step = basis @ solve(ne, 1e-3)
     v_c, w = step[:3], step[3:]  # a world twist about the root's position c

@@ -28,7 +28,7 @@ def view_octaves(skeleton: Skeleton, pose: BodyPose) -> list[int]:
     """Per view, how many times the body at ``pose`` is twice as tall there as
     ``REFERENCE_BODY_PIXELS`` (its rest pose's largest extent, rounded in octaves; 0 for a
     body no larger)."""
-    return [max(0, int(np.round(np.log2(skeleton.height() * v.pose.s
+    return [max(0, int(np.round(np.log2(skeleton.height() * v.scale_at(pose.root_position)
                                         / REFERENCE_BODY_PIXELS)))) for v in pose.views]
 
 

@@ -15,7 +15,7 @@ the segment's outline area, and by that again for each ``TURN_SCALE`` degrees of
 squared (a prior on how far a limb strays from its predicted motion: a forearm predicted
 within a few degrees was turned 45-55 about its shoulder onto foreground the trunk's blob
 leaves uncovered). Outlines are unions of projected ellipses
-(``raycast.shadows``), so the search needs no depth order. Grids in degrees; pixels on one
+(``Camera.ellipses``), so the search needs no depth order. Grids in degrees; pixels on one
 pyramid level.
 """
 
@@ -28,11 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import se3
-from .camera import View
+from .camera import Camera
 from .confidence import Limbs
 from .linearize import Kinematics
 from .pose import BodyPose
-from .raycast import BlobStack, blob_frames, shadows
+from .raycast import BlobStack, blob_frames
 from .skeleton import BALL, HINGE, Skeleton
 
 SWING = (np.arange(-60, 61, 15), np.arange(-10, 11, 5))  # coarse grid, then around the best
@@ -54,10 +54,10 @@ class _Limb:
     dofs: list  # (joint, local axis, (coarse grid, fine grid)), parents first
 
 
-def outlines(view: View, A: np.ndarray, C: np.ndarray):
+def outlines(view: Camera, A: np.ndarray, C: np.ndarray):
     """Each ellipsoid's outline as row spans: centres c (..., 2), row range (..., 2) and the
-    forms P (..., 2, 2) of ``raycast.shadows``."""
-    c, P = shadows(view, A, C)
+    forms P (..., 2, 2) of ``Camera.ellipses``."""
+    c, P = view.ellipses(A, C)
     det = np.linalg.det(P)
     half = np.sqrt(np.stack([P[..., 1, 1], P[..., 0, 0]], -1) / det[..., None])
     return c, half, P
@@ -92,7 +92,7 @@ def spans(c, half, P, box):
     return lo.astype(int), hi.astype(int)
 
 
-def paint(mask: np.ndarray, view: View, A: np.ndarray, C: np.ndarray, box: tuple) -> None:
+def paint(mask: np.ndarray, view: Camera, A: np.ndarray, C: np.ndarray, box: tuple) -> None:
     """Set the pixels of ``mask`` (the box's size) that any ellipsoid's outline covers."""
     c, half, P = outlines(view, A, C)
     lo, hi = spans(c, half, P, box)
@@ -146,7 +146,7 @@ class LimbSearch:
                     dofs.insert(0, (p, skeleton.bone_frame(p)[0], TWIST))
             self.limbs.append(_Limb(j, np.flatnonzero(own), np.flatnonzero(below), dofs))
 
-    def run(self, pose: BodyPose, views: Sequence[View], fgs: Sequence[np.ndarray | None]
+    def run(self, pose: BodyPose, views: Sequence[Camera], fgs: Sequence[np.ndarray | None]
             ) -> tuple[BodyPose, list[str]]:
         """The pose with each limb turned to its best place, and the joints that turned.
         ``views`` and ``fgs`` (boolean masks; None for a view without one) share one level; a
@@ -165,7 +165,7 @@ class LimbSearch:
             if n_views == 1:
                 view = next(v for v, fg in zip(views, fgs) if fg is not None)
                 j, axis, _ = limb.dofs[-1]
-                if (self.sk.kinds[j] != HINGE or abs(view.pose.R[2] @ kin.frames[j, :3, :3]
+                if (self.sk.kinds[j] != HINGE or abs(view.orientation[2] @ kin.frames[j, :3, :3]
                                                       @ axis) < SIDE_ON):
                     continue
                 limb = _Limb(limb.joint, limb.own, limb.below, limb.dofs[-1:])
@@ -180,7 +180,7 @@ class LimbSearch:
         return pose, turned
 
     @staticmethod
-    def _foreground_share(view: View, fg: np.ndarray, A, C) -> float:
+    def _foreground_share(view: Camera, fg: np.ndarray, A, C) -> float:
         """How much of the body's outline is foreground: low when the body's brightness is
         close to its backdrop's (then holes in a limb's outline would make hiding it pay) or
         when the body as a whole is far off."""
@@ -189,7 +189,7 @@ class LimbSearch:
         return float(fg[body].mean()) if body.any() else 0.0
 
     @staticmethod
-    def _gain_sums(view: View, fg: np.ndarray, A, C, box) -> np.ndarray:
+    def _gain_sums(view: Camera, fg: np.ndarray, A, C, box) -> np.ndarray:
         """Row prefix sums (rows, cols + 1) over ``box`` of what covering each pixel costs:
         nothing where the ellipsoids A, C (the rest of the body) cover it, else 1 on the
         background and -``UNCOVERED_GAIN`` on the foreground."""

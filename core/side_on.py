@@ -22,7 +22,7 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
     footage shows such a turn only as foreshortening, the same for either sign. A ball joint
     is always one; a hinge is not when its axis at ``pose`` lies within 25 degrees of the
     line of sight (it turns in the image plane). Empty when the views look different ways."""
-    sight = [v.pose.R[2] for v in pose.views]
+    sight = [v.orientation[2] for v in pose.views]
     if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
         return []
     frames = Kinematics(skeleton, pose).frames
@@ -46,7 +46,7 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
     for j in blind:
         kinds[j] = HINGE
-        axes[j] = frames[j, :3, :3].T @ pose.views[0].pose.R[2]
+        axes[j] = frames[j, :3, :3].T @ pose.views[0].orientation[2]
         limits[j] = (-np.inf, np.inf)
     out = Skeleton(skeleton.names, skeleton.parents, skeleton.offsets, kinds, axes,
                    skeleton.end_sites, limits=limits)

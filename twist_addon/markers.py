@@ -45,7 +45,8 @@ def point_of_pixel(cam, scene, pixels, depth_point) -> np.ndarray:
     """The world points (..., 3) on the rays of ``pixels`` (..., 2) through ``cam`` nearest
     to ``depth_point`` (where to draw markers so that they sit among the bones)."""
     origin, d = view_from_camera(cam, scene).ray(np.asarray(pixels, float))
-    return origin + d * ((np.asarray(depth_point, float) - origin) @ d)[..., None]
+    along = np.sum((np.asarray(depth_point, float) - origin) * d, axis=-1, keepdims=True)
+    return origin + d * along
 
 
 def next_bone(arm, bone: str) -> str:

@@ -12,6 +12,7 @@ import pytest
 from core import se3
 from core.bvh import read_bvh, write_bvh
 from core.job import JobError, load_job, parse_camera
+from core.lens import undistort_points
 from core.pose import BodyPose
 from support.synthetic import render
 
@@ -229,7 +230,7 @@ def test_a_corrected_frame_takes_its_given_pose_and_the_others_are_tracked(foota
         (lambda j: j["views"][0]["camera"].update(R=[[1, 0, 0], [0, 2, 0], [0, 0, 1]]),
          r"job.json.views\[0\].camera.R: expected a 3x3 rotation matrix"),
         (lambda j: j["views"][0]["camera"].update(model="perspective"),
-         "only 'scaled_orthographic' is supported"),
+         "expected 'pinhole' or 'scaled_orthographic', got 'perspective'"),
         (lambda j: j["skeleton"]["joints"].update(Tail="ball"),
          "job.json.skeleton.joints.Tail: no such joint"),
         (lambda j: j["skeleton"]["joints"].update(LeftKnee={"kind": "hinge"}),
@@ -289,7 +290,8 @@ def test_a_tracked_joint_with_nothing_away_from_it_is_refused(footage, tmp_path)
 
 
 def test_camera_parsing_maps_world_points_as_documented():
-    view = parse_camera(CAMERA, "cam")
+    view, dist = parse_camera(CAMERA, "cam")
+    assert dist is None
     X = np.array([0.2, 1.0, -0.4])
     R, t = np.array(CAMERA["R"], float), np.array(CAMERA["t"])
     expect = 150 * (R @ X + t)[:2] + np.array(CAMERA["center"])
@@ -337,3 +339,99 @@ def test_hinge_limits_are_read_in_degrees(footage, tmp_path):
     sk = load_job(path).skeleton
     np.testing.assert_allclose(np.degrees(sk.limits[sk.index("LeftKnee")]), [-5, 150])
     assert np.all(np.isinf(sk.limits[sk.index("RightKnee")]))  # none given: free
+
+
+def _pinhole(camera: dict, dist=None) -> dict:
+    """The pinhole twin of a scaled orthographic test camera: 3 units from the body, with
+    the focal length that shows it as large."""
+    f = camera["scale"] * 3.0
+    out = {"model": "pinhole", "K": [[f, 0, camera["center"][0]], [0, f, camera["center"][1]],
+                                     [0, 0, 1]],
+           "R": camera["R"], "t": camera["t"][:2] + [3.0]}
+    return out if dist is None else dict(out, dist=dist)
+
+
+LENS = [-0.25, 0.08, 0.002, -0.001, 0.0]  # a wide lens's barrel distortion, OpenCV's model
+
+
+@pytest.fixture(scope="module")
+def pinhole_footage(tmp_path_factory, footage):
+    """The walk of ``footage`` filmed through three pinhole cameras 3 units away; the first
+    view's lens distorts (its frames as filmed, the job gives ``dist``)."""
+    src_folder, src_job = footage
+    folder = tmp_path_factory.mktemp("pinhole_job")
+    (folder / "walk.bvh").write_bytes((src_folder / "walk.bvh").read_bytes())
+    cams = [_pinhole(CAMERA, LENS), _pinhole(FRONT), _pinhole(OBLIQUE)]
+    job = dict(src_job, views=[dict(v, camera=c) for v, c in zip(src_job["views"], cams)])
+    job.pop("mode")  # pinhole cameras are calibrated
+    (folder / "job.json").write_text(json.dumps(job))
+    for v in ("side", "front", "oblique"):
+        (folder / v).mkdir()
+        for f in range(3):
+            cv2.imwrite(str(folder / v / f"{f:03d}.png"), np.zeros((4, 4), np.uint8))
+    loaded = load_job(folder / "job.json")
+    assert loaded.mode == "calibrated"
+    b = read_bvh(folder / "walk.bvh")
+    R, p = b.poses()
+    H, W = 300, 320
+    ys, xs = np.mgrid[0:H, 0:W].astype(np.float32)
+    K = np.array(cams[0]["K"], float)
+    ideal = undistort_points(np.stack([xs.ravel(), ys.ravel()], 1), K, np.array(LENS))
+    for c, v in enumerate(["side", "front", "oblique"]):
+        for f in range(3):
+            img = render(loaded.skeleton, BodyPose(R[f], p[f], loaded.cameras), c,
+                         shape=(H, W), noise=0.01, seed=f)
+            if c == 0:  # as the lens shows it: each filmed pixel sees its ideal point
+                maps = ideal.reshape(H, W, 2).astype(np.float32)
+                img = cv2.remap(img.astype(np.float32), maps[..., 0], maps[..., 1],
+                                cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+            cv2.imwrite(str(folder / v / f"{f:03d}.png"), (img * 255).astype(np.uint8))
+    return folder, job
+
+
+def test_pinhole_views_with_a_distorting_lens_track_as_the_orthographic_ones(pinhole_footage,
+                                                                              tmp_path):
+    folder, job = pinhole_footage
+    out = tmp_path / "out.bvh"
+    proc = _run("track", folder / "job.json", "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    src, got = read_bvh(folder / "walk.bvh"), read_bvh(out)
+    R_true, p_true = src.poses()
+    R_got, p_got = got.poses()
+    sk = load_job(folder / "job.json").skeleton
+    for f in range(3):
+        X, Y = sk.world_positions(R_got[f], p_got[f]), sk.world_positions(R_true[f], p_true[f])
+        for a, b in [("LeftHip", "LeftKnee"), ("LeftKnee", "LeftAnkle"),
+                     ("RightHip", "RightKnee"), ("RightKnee", "RightAnkle")]:
+            ja, jb = sk.index(a), sk.index(b)
+            err = se3.angle_between_vectors(X[jb] - X[ja], Y[jb] - Y[ja])
+            assert np.degrees(err) < 2.0, (f, a)
+        assert np.linalg.norm(p_got[f] - p_true[f]) < 0.01  # depth too: a pinhole sees it
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda c: c["K"][1].__setitem__(0, 5.0), r"camera.K: expected an upper triangular"),
+        (lambda c: c["K"][0].__setitem__(0, -450.0),
+         r"camera.K: the focal lengths fx = -450, fy = 450 \(pixels\) must be > 0"),
+        (lambda c: c.update(t=c["t"][:2] + [-3.0]),
+         r"job.json.initial: the joint '\w+' lies behind view 1's camera"),
+        (lambda c: c.update(dist=[0.1, 0.2]), r"camera.dist: expected OpenCV's distortion"),
+    ],
+)
+def test_malformed_pinhole_cameras_get_one_clear_error(pinhole_footage, change, message):
+    folder, job = pinhole_footage
+    bad = json.loads(json.dumps(job))
+    change(bad["views"][0]["camera"])
+    path = folder / "job.json"
+    good = path.read_text()
+    path.write_text(json.dumps(bad))
+    try:
+        with pytest.raises(JobError, match=message):
+            load_job(path)
+        path.write_text(json.dumps(dict(job, mode="independent")))
+        with pytest.raises(JobError, match="view 1's camera is a pinhole.*'calibrated'"):
+            load_job(path)
+    finally:
+        path.write_text(good)

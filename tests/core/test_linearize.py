@@ -7,29 +7,31 @@ from core import se3
 from core.linearize import Kinematics, rows
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, n_root_params
 from core.skeleton import human_template
-from support.synthetic import side_view
+from support.synthetic import side_pinhole, side_view
 
 
-def _pose(seed=0):
+def _pose(seed=0, pinhole=False):
     sk = human_template()
     rng = np.random.default_rng(seed)
     R = np.array([se3.exp_so3(rng.normal(0, 0.4, 3)) for _ in range(sk.n_joints)])
-    views = [side_view(yaw_deg=90), side_view(yaw_deg=30, scale=140.0)]
+    camera = side_pinhole if pinhole else side_view
+    views = [camera(yaw_deg=90), camera(yaw_deg=30, scale=140.0)]
     return sk, BodyPose(R, sk.rest_positions[0] + 0.1, views)
 
 
-@pytest.mark.parametrize("mode", [CALIBRATED, INDEPENDENT])
+@pytest.mark.parametrize("mode, pinhole", [(CALIBRATED, False), (INDEPENDENT, False),
+                                           (CALIBRATED, True)])
 @pytest.mark.parametrize("view", [0, 1])
-def test_rows_match_finite_differences(mode, view):
-    sk, pose = _pose()
+def test_rows_match_finite_differences(mode, pinhole, view):
+    sk, pose = _pose(pinhole=pinhole)
     kin = Kinematics(sk, pose)
     P = n_root_params(mode, 2) + len(kin.dof_joint)
     # one point on every blob: the root's segment and joints deep in the chain (elbows, knees)
     seg = np.array([b.joint for b in sk.blobs])
     ref = np.array([b.centre for b in sk.blobs]) + 0.02
-    q = pose.views[view].scaled(kin.world_points(seg, ref))
+    X = kin.world_points(seg, ref)
     # grad = e_x and e_y read off the x and y pixel motion separately
-    A = np.stack([rows(kin, view, mode, seg, q, np.tile(e, (len(q), 1))) for e in np.eye(2)], 1)
+    A = np.stack([rows(kin, view, mode, seg, X, np.tile(e, (len(X), 1))) for e in np.eye(2)], 1)
     num = np.zeros_like(A)
     h = 1e-6
     for k in range(P):
@@ -52,7 +54,9 @@ def test_independent_root_rows_are_the_papers_eq_18():
     kin = Kinematics(sk, pose)
     q = np.array([[3.0, -4.0, 7.0]])
     g = np.array([[0.5, -2.0]])
-    A = rows(kin, 0, INDEPENDENT, np.array([0]), q, g)
+    P = pose.views[0].pose
+    X = P.R.T @ (q[0] / P.s - P.t)  # the world point at q
+    A = rows(kin, 0, INDEPENDENT, np.array([0]), X[None], g)
     d = q[0] - pose.views[0].scaled(kin.frames[0, :3, 3])  # pivot at the root's image point
     Ix, Iy = g[0]
     x, y, z = d

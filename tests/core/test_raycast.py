@@ -1,10 +1,14 @@
 """Ray casting against brute-force sampling along each pixel's ray."""
 
 import numpy as np
+import pytest
 
 from core import raycast, se3
 from core.skeleton import human_template
-from support.synthetic import side_view
+from support.synthetic import side_pinhole, side_view
+
+CAMERAS = pytest.mark.parametrize("camera", [side_view, side_pinhole],
+                                  ids=["orthographic", "pinhole"])
 
 
 def _posed(seed=3):
@@ -22,29 +26,31 @@ def _inside(sk, g, X):
     return np.sum(y * y, -1) <= 1
 
 
-def test_depths_match_brute_force_marching():
+@CAMERAS
+def test_depths_match_brute_force_marching(camera):
     sk, g = _posed()
-    view = side_view(yaw_deg=35)
+    view = camera(yaw_deg=35)
     rng = np.random.default_rng(0)
     pix = rng.uniform([100, 30], [220, 330], size=(400, 2))
     hits = raycast.cast(view, pix, sk.blobs, g)
     assert (hits.label >= 0).sum() > 40
     origin, d = view.ray(pix)
-    lam = np.linspace(0, 10, 10001)  # 1 mm steps from the camera plane through the body
+    lam = np.linspace(0, 10, 10001)  # 1 mm steps from the camera (plane) through the body
     for i in np.flatnonzero(hits.label >= 0)[:40]:
-        X = origin[i] + lam[:, None] * d
+        X = origin[i] + lam[:, None] * d[i]
         inside = _inside(sk, g, X)
         first = int(np.argmax(inside.any(1)))
         assert abs(lam[first] - hits.depth[i]) < 1.5e-3
         assert inside[first, hits.label[i]]  # the nearest surface belongs to the reported blob
     for i in np.flatnonzero(hits.label < 0)[:40]:
-        X = origin[i] + lam[:, None] * d
+        X = origin[i] + lam[:, None] * d[i]
         assert not _inside(sk, g, X).any()
 
 
-def test_rasterised_labels_equal_per_pixel_casting():
+@CAMERAS
+def test_rasterised_labels_equal_per_pixel_casting(camera):
     sk, g = _posed(5)
-    view = side_view(yaw_deg=70)
+    view = camera(yaw_deg=70)
     for step in (1, 3):
         pix, hits, box = raycast.render_labels(view, sk.blobs, g, (360, 320), step)
         ref = raycast.cast(view, pix, sk.blobs, g)
@@ -61,11 +67,54 @@ def test_rasterised_labels_equal_per_pixel_casting():
         assert (every.label >= 0).sum() == len(pix)  # no covered pixel of the box is missed
 
 
-def test_hit_points_lie_on_their_blob_surface():
+@CAMERAS
+def test_hit_points_lie_on_their_blob_surface(camera):
     sk, g = _posed(7)
-    view = side_view(yaw_deg=10)
+    view = camera(yaw_deg=10)
     pix, hits, _ = raycast.render_labels(view, sk.blobs, g, (360, 320))
     A, C = raycast.blob_frames(sk.blobs, g)
     y = np.einsum("nab,nb->na", A[hits.label], hits.world - C[hits.label])
     np.testing.assert_allclose(np.linalg.norm(y, axis=1), 1.0, atol=1e-9)
     np.testing.assert_allclose(view.project(hits.world), pix, atol=1e-9)
+
+
+@CAMERAS
+def test_outline_ellipses_bound_the_cast_pixels(camera):
+    """A pixel is inside a blob's outline (``Camera.ellipses``) exactly where its ray meets
+    that blob, and the blob boxes hold every such pixel."""
+    sk, g = _posed(9)
+    view = camera(yaw_deg=50)
+    A, C = raycast.blob_frames(sk.blobs, g)
+    c, P = view.ellipses(A, C)
+    boxes = raycast.blob_boxes(view, sk.blobs, g)
+    rng = np.random.default_rng(2)
+    pix = rng.uniform([60, 0], [260, 360], size=(3000, 2))
+    origin, d = view.ray(pix)
+    for e in range(len(sk.blobs)):  # the ray against this blob alone
+        w, v = (origin - C[e]) @ A[e].T, d @ A[e].T
+        b, a = np.sum(w * v, 1), np.sum(v * v, 1)
+        meets = b * b - a * (np.sum(w * w, 1) - 1) > 0
+        r = pix - c[e]
+        inside = np.einsum("na,ab,nb->n", r, P[e], r) <= 1
+        near = np.abs(np.einsum("na,ab,nb->n", r, P[e], r) - 1) < 1e-6
+        assert np.all((meets == inside) | near)
+        lo, hi = boxes[e, :2], boxes[e, 2:]
+        assert np.all((pix[meets] >= lo - 1e-9) & (pix[meets] <= hi + 1e-9))
+        # the box is tight: its edges touch the outline
+        edge = np.stack([np.full(4001, lo[0]), np.linspace(lo[1], hi[1], 4001)], 1)
+        assert np.min(np.einsum("na,ab,nb->n", edge - c[e], P[e], edge - c[e])) == \
+            pytest.approx(1.0, abs=1e-4)
+
+
+def test_a_pinhole_shows_nearer_blobs_larger():
+    """Two equal blobs at different depths: through a pinhole the nearer one's outline is
+    larger by the depths' ratio, under orthography they are equal."""
+    from core.skeleton import Ellipsoid
+    blobs = [Ellipsoid(0, f"ball{z}", np.array([0.0, 0.9, z]), np.full(3, 0.1), np.eye(3))
+             for z in (0.0, 1.0)]
+    g = np.eye(4)[None]
+    for camera, ratio in ((side_view, 1.0), (side_pinhole, 3.0 / 2.0)):
+        view = camera(yaw_deg=0)  # looking along -z: the second blob is 1 unit nearer
+        boxes = raycast.blob_boxes(view, blobs, g)
+        widths = boxes[:, 2] - boxes[:, 0]
+        assert widths[1] / widths[0] == pytest.approx(ratio, rel=0.02)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from core import raycast, se3
-from core.camera import View
+from core.camera import Pinhole, View
 from core.pose import BodyPose
 
 
@@ -50,3 +50,14 @@ def side_view(scale=160.0, center=(160, 180), yaw_deg=90.0, height=0.9) -> View:
     R = flip @ se3.exp_so3(np.array([0, np.radians(yaw_deg), 0]))
     t = -R @ np.array([0, height, 0]) + np.array([0, 0, 5.0])
     return View(se3.Similarity(scale, R, t), np.array(center, dtype=float))
+
+
+def side_pinhole(scale=160.0, center=(160, 180), yaw_deg=90.0, height=0.9, distance=3.0
+                 ) -> Pinhole:
+    """``side_view``'s pinhole twin: the camera ``distance`` world units from (0, height, 0),
+    with the focal length that shows that point's depth at ``scale`` pixels per unit."""
+    flip = np.diag([1.0, -1.0, -1.0])
+    R = flip @ se3.exp_so3(np.array([0, np.radians(yaw_deg), 0]))
+    t = -R @ np.array([0, height, 0]) + np.array([0, 0, distance])
+    f = scale * distance
+    return Pinhole(np.array([[f, 0, center[0]], [0, f, center[1]], [0, 0, 1.0]]), R, t)
