@@ -3,14 +3,17 @@
     twist-mocap track JOB.json --out TRACKED.bvh [--report REPORT.json]
     twist-mocap fit FIT.json --out FITTED.bvh
     twist-mocap plate PLATE.png --out FOLDER [--per-row N]
+    twist-mocap cameras CALIBRATION --out cameras.json [--scale UNITS_PER_METRE]
 
 (``python -m core`` with the project's Python does the same.) A job names the body (a BVH
 and the joints to track), the first frame's pose, each view's footage and camera, and
 settings; docs/JOB_FORMAT.md describes every field. ``plate`` cuts a printed plate (cells
 in rows with dark gutters) into one image per cell, lined up on the ground line, named
-PLATE_01.png, PLATE_02.png, ... in reading order. Exit status: 0 done; 2 the job, its
+PLATE_01.png, PLATE_02.png, ... in reading order. ``cameras`` converts a calibration
+(OpenCV's YAML/XML/JSON, Pose2Sim's TOML, Qualisys' .qca.txt) into pinhole cameras a job's
+views take as they are. Exit status: 0 done; 2 the job, its
 footage or the output paths are unusable, the clicks cannot determine a fit, or the
-plate's cells cannot be found (nothing written); 3 tracking stopped at a diverged frame
+plate's cells or the calibration cannot be read (nothing written); 3 tracking stopped at a diverged frame
 (the frames before it are written).
 """
 
@@ -24,6 +27,7 @@ import time
 from pathlib import Path
 
 from .bvh import write_bvh
+from .calibration import CalibrationError, read_calibration, write_cameras
 from .confidence import frame_list
 from .errors import InputError
 from .init_fit import FitError, fit_pose, least_certain
@@ -143,6 +147,27 @@ def _plate(args) -> int:
     return 0
 
 
+def _cameras(args) -> int:
+    problem = _writable(args.out, "cameras file")
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
+    try:
+        cams = read_calibration(args.calibration, args.scale)
+    except CalibrationError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    write_cameras(cams, args.out)
+    for c in cams:
+        size = f"{c.size[0]}x{c.size[1]}" if c.size else "size not given"
+        centre = ", ".join(f"{x:.3f}" for x in c.camera.centre)
+        print(f"{c.name}: {size}, focal length {c.camera.K[0, 0]:.1f} px, centre ({centre}), "
+              f"{'lens distortion' if c.dist is not None else 'no distortion'}",
+              file=sys.stderr)
+    print(f"{len(cams)} cameras -> {args.out}", file=sys.stderr)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="twist-mocap", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -161,8 +186,16 @@ def main(argv=None) -> int:
     pl.add_argument("--out", required=True, help="the folder to write the frames into")
     pl.add_argument("--per-row", type=int, help="cells per row, where the plate's cells "
                     "touch with no gutter between them and their count is not found")
+    ca = sub.add_parser("cameras", help="convert a calibration file into the pinhole cameras "
+                        "a job takes")
+    ca.add_argument("calibration", help="OpenCV .yml/.yaml/.xml/.json, Pose2Sim .toml or "
+                    "Qualisys .qca.txt")
+    ca.add_argument("--out", required=True, help="the cameras file (JSON) to write")
+    ca.add_argument("--scale", type=float, default=1.0, help="world units per metre, for a "
+                    "skeleton in other units (100 for centimetres); default 1")
     args = ap.parse_args(argv)
-    return {"track": _track, "fit": _fit, "plate": _plate}[args.command](args)
+    return {"track": _track, "fit": _fit, "plate": _plate, "cameras": _cameras}[
+        args.command](args)
 
 
 if __name__ == "__main__":

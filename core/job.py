@@ -18,6 +18,7 @@ import numpy as np
 
 from . import se3
 from .bvh import BvhError, BvhFile, read_bvh
+from .calibration import CalibrationError, read_calibration
 from .camera import Camera, Pinhole, View
 from .errors import InputError
 from .image import ImageError
@@ -95,12 +96,38 @@ def _intrinsics(d: dict, where: str) -> np.ndarray:
     return K
 
 
-def parse_camera(d, where: str) -> tuple[Camera, np.ndarray | None]:
+def _calibrated(d: dict, base: Path, where: str) -> tuple[Camera, np.ndarray | None]:
+    """The camera named ``name`` in the calibration file ``calibration`` (the only one when
+    it holds one), its world scaled by ``scale``."""
+    file = _field(d, "calibration", where, str)
+    scale = d.get("scale", 1.0)
+    if not isinstance(scale, (int, float)) or not scale > 0:
+        raise JobError(f"{where}.scale: expected world units per metre > 0, got {scale!r}")
+    try:
+        cams = read_calibration(base / file, scale)
+    except CalibrationError as e:
+        raise JobError(f"{where}.calibration: {e}") from None
+    names = [c.name for c in cams]
+    if "name" not in d and len(cams) > 1:
+        raise JobError(f"{where}.name: '{file}' holds {len(cams)} cameras ({', '.join(names)})"
+                       ": name this view's")
+    name = d.get("name", names[0])
+    if name not in names:
+        raise JobError(f"{where}.name: '{file}' has no camera '{name}' (it has "
+                       f"{', '.join(names)})")
+    cam = cams[names.index(name)]
+    return cam.camera, cam.dist
+
+
+def parse_camera(d, where: str, base: Path = Path(".")) -> tuple[Camera, np.ndarray | None]:
     """A view's camera and its lens distortion (OpenCV's k1, k2, p1, p2[, k3[, ...]]; None:
-    none): ``scaled_orthographic`` (R, t, scale, center) or ``pinhole`` (K, R, t, and
-    optionally dist)."""
+    none): ``scaled_orthographic`` (R, t, scale, center), ``pinhole`` (K, R, t, and
+    optionally dist), or a camera of a calibration file (``calibration``, relative to
+    ``base``, and ``name``)."""
     if not isinstance(d, dict):
         raise JobError(f"{where}: expected an object with model and the model's fields")
+    if "calibration" in d:
+        return _calibrated(d, base, where)
     model = _field(d, "model", where, str)
     if model == "pinhole":
         K, R = _intrinsics(d, where), _rotation(d, where)
@@ -316,13 +343,13 @@ def _corrections(spec, sk: Skeleton, bvh: BvhFile, bvh_path: Path, base: Path,
     return out
 
 
-def _views(d: dict, where: str) -> tuple[list[dict], list[Camera], list]:
+def _views(d: dict, base: Path, where: str) -> tuple[list[dict], list[Camera], list]:
     """The ``views`` field (at least one), each view's camera and its lens distortion."""
     views = _field(d, "views", where, list)
     if not views:
         raise JobError(f"{where}.views: expected at least one view")
     parsed = [parse_camera(_field(v, "camera", f"{where}.views[{i}]"),
-                           f"{where}.views[{i}].camera") for i, v in enumerate(views)]
+                           f"{where}.views[{i}].camera", base) for i, v in enumerate(views)]
     return views, [c for c, _ in parsed], [dist for _, dist in parsed]
 
 
@@ -359,7 +386,7 @@ def load_job(path: str | Path) -> Job:
     d = _read_json(path, "job file")
     base, where = path.parent, path.name
     sk, bvh, bvh_path, init_bvh, frame = _body(d, base, where)
-    views, cameras, dists = _views(d, where)
+    views, cameras, dists = _views(d, base, where)
     images = [_images(_field(v, "images", f"{where}.views[{i}]"), base,
                       f"{where}.views[{i}].images") for i, v in enumerate(views)]
     images = [x if dist is None else Undistorted(x, cam.K, dist)
@@ -404,7 +431,7 @@ def load_fit(path: str | Path) -> FitJob:
     d = _read_json(path, "fit file")
     base, where = path.parent, path.name
     sk, bvh, _, init_bvh, frame = _body(d, base, where)
-    views, cameras, dists = _views(d, where)
+    views, cameras, dists = _views(d, base, where)
     clicks_in = _field(d, "clicks", where, list)
     if len(clicks_in) != len(views):
         raise JobError(f"{where}.clicks: expected one object per view ({len(views)}), got "
