@@ -11,10 +11,10 @@ settings; docs/JOB_FORMAT.md describes every field. ``plate`` cuts a printed pla
 in rows with dark gutters) into one image per cell, lined up on the ground line, named
 PLATE_01.png, PLATE_02.png, ... in reading order. ``cameras`` converts a calibration
 (OpenCV's YAML/XML/JSON, Pose2Sim's TOML, Qualisys' .qca.txt) into pinhole cameras a job's
-views take as they are. Exit status: 0 done; 2 the job, its
-footage or the output paths are unusable, the clicks cannot determine a fit, or the
-plate's cells or the calibration cannot be read (nothing written); 3 tracking stopped at a diverged frame
-(the frames before it are written).
+views take as they are. Exit status: 0 done; 2 the job, its footage or the output paths are
+unusable, the clicks cannot determine a fit, or the plate's cells or the calibration cannot
+be read (nothing written); 3 tracking stopped at a diverged frame (the frames before it are
+written).
 """
 
 from __future__ import annotations
