@@ -45,6 +45,8 @@ class Job:
     settings: TrackerSettings
     frame_time: float
     corrections: dict[int, BodyPose] = dataclasses.field(default_factory=dict)  # by image
+    moving: list = dataclasses.field(default_factory=list)  # per view: its camera per frame
+    # where it moves, else None (``Tracker``'s ``moving``)
 
 
 def _field(d: dict, key: str, where: str, kind=None):
@@ -67,16 +69,38 @@ def _vector(v, n: int, where: str) -> np.ndarray:
     return a
 
 
-def _rotation(d: dict, where: str) -> np.ndarray:
+def _is_rotation(R: np.ndarray) -> bool:
+    return bool(np.allclose(R @ R.T, np.eye(3), atol=1e-4) and np.linalg.det(R) > 0)
+
+
+def _poses(d: dict, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """A camera's ``R`` and ``t``: one of each for a camera that stands still, or one per
+    frame for one that moves (F, 3, 3) and (F, 3); a still camera's F is 1."""
     try:
         R = np.asarray(_field(d, "R", where), dtype=float)
     except (TypeError, ValueError):
-        raise JobError(f"{where}.R: expected a 3x3 rotation matrix (list of 3 rows)") from None
-    if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-4) or np.linalg.det(
-        R
-    ) < 0:
-        raise JobError(f"{where}.R: expected a 3x3 rotation matrix (orthonormal, det +1)")
-    return R
+        R = np.zeros(0)
+    if R.shape == (3, 3):
+        R = R[None]
+    if R.ndim != 3 or R.shape[1:] != (3, 3):
+        raise JobError(f"{where}.R: expected a 3x3 rotation matrix (list of 3 rows), or one "
+                       "per frame for a camera that moves")
+    bad = [i for i, r in enumerate(R) if not _is_rotation(r)]
+    if bad:
+        at = f" (frame {bad[0]})" if len(R) > 1 else ""
+        raise JobError(f"{where}.R: expected a 3x3 rotation matrix (orthonormal, det +1){at}")
+    try:
+        t = np.asarray(_field(d, "t", where), dtype=float)
+    except (TypeError, ValueError):
+        t = np.zeros(0)
+    t = t[None] if t.shape == (3,) else t
+    if t.ndim != 2 or t.shape[1] != 3 or not np.all(np.isfinite(t)):
+        raise JobError(f"{where}.t: expected 3 finite numbers, or 3 per frame for a camera "
+                       f"that moves, got {d['t']!r}")
+    if len(R) != len(t) and 1 not in (len(R), len(t)):
+        raise JobError(f"{where}: R is given on {len(R)} frames, t on {len(t)}")
+    n = max(len(R), len(t))
+    return np.broadcast_to(R, (n, 3, 3)), np.broadcast_to(t, (n, 3))
 
 
 def _intrinsics(d: dict, where: str) -> np.ndarray:
@@ -119,19 +143,20 @@ def _calibrated(d: dict, base: Path, where: str) -> tuple[Camera, np.ndarray | N
     return cam.camera, cam.dist
 
 
-def parse_camera(d, where: str, base: Path = Path(".")) -> tuple[Camera, np.ndarray | None]:
-    """A view's camera and its lens distortion (OpenCV's k1, k2, p1, p2[, k3[, ...]]; None:
-    none): ``scaled_orthographic`` (R, t, scale, center), ``pinhole`` (K, R, t, and
-    optionally dist), or a camera of a calibration file (``calibration``, relative to
-    ``base``, and ``name``)."""
+def parse_camera(d, where: str, base: Path = Path(".")
+                 ) -> tuple[list[Camera], np.ndarray | None]:
+    """A view's camera, one per frame where it moves (else one), and its lens distortion
+    (OpenCV's k1, k2, p1, p2[, k3[, ...]]; None: none): ``scaled_orthographic`` (R, t,
+    scale, center), ``pinhole`` (K, R, t, and optionally dist), or a camera of a calibration
+    file (``calibration``, relative to ``base``, and ``name``)."""
     if not isinstance(d, dict):
         raise JobError(f"{where}: expected an object with model and the model's fields")
     if "calibration" in d:
-        return _calibrated(d, base, where)
+        cam, dist = _calibrated(d, base, where)
+        return [cam], dist
     model = _field(d, "model", where, str)
     if model == "pinhole":
-        K, R = _intrinsics(d, where), _rotation(d, where)
-        t = _vector(_field(d, "t", where), 3, f"{where}.t")
+        K, (Rs, ts) = _intrinsics(d, where), _poses(d, where)
         dist = None
         if d.get("dist") is not None:
             try:
@@ -145,17 +170,17 @@ def parse_camera(d, where: str, base: Path = Path(".")) -> tuple[Camera, np.ndar
                                f"{d['dist']!r}")
             if not np.any(dist):
                 dist = None
-        return Pinhole(K, R, t), dist
+        return [Pinhole(K, R.copy(), t.copy()) for R, t in zip(Rs, ts)], dist
     if model != "scaled_orthographic":
         raise JobError(f"{where}.model: expected 'pinhole' or 'scaled_orthographic', got "
                        f"'{model}'")
-    R = _rotation(d, where)
-    t = _vector(_field(d, "t", where), 3, f"{where}.t")
+    Rs, ts = _poses(d, where)
     scale = _field(d, "scale", where, (int, float))
     if not scale > 0:
         raise JobError(f"{where}.scale: expected pixels per world unit > 0, got {scale}")
     center = _vector(_field(d, "center", where), 2, f"{where}.center")
-    return View(se3.Similarity(scale, R, t), center), None
+    return [View(se3.Similarity(scale, R.copy(), t.copy()), center.copy())
+            for R, t in zip(Rs, ts)], None
 
 
 def _images(spec, base: Path, where: str):
@@ -343,8 +368,9 @@ def _corrections(spec, sk: Skeleton, bvh: BvhFile, bvh_path: Path, base: Path,
     return out
 
 
-def _views(d: dict, base: Path, where: str) -> tuple[list[dict], list[Camera], list]:
-    """The ``views`` field (at least one), each view's camera and its lens distortion."""
+def _views(d: dict, base: Path, where: str) -> tuple[list[dict], list[list[Camera]], list]:
+    """The ``views`` field (at least one), each view's camera (one per frame where it moves)
+    and its lens distortion."""
     views = _field(d, "views", where, list)
     if not views:
         raise JobError(f"{where}.views: expected at least one view")
@@ -386,7 +412,8 @@ def load_job(path: str | Path) -> Job:
     d = _read_json(path, "job file")
     base, where = path.parent, path.name
     sk, bvh, bvh_path, init_bvh, frame = _body(d, base, where)
-    views, cameras, dists = _views(d, base, where)
+    views, paths, dists = _views(d, base, where)
+    cameras = [p[0] for p in paths]
     images = [_images(_field(v, "images", f"{where}.views[{i}]"), base,
                       f"{where}.views[{i}].images") for i, v in enumerate(views)]
     images = [x if dist is None else Undistorted(x, cam.K, dist)
@@ -398,6 +425,16 @@ def load_job(path: str | Path) -> Job:
     if min(counts) < 2:
         raise JobError(f"{where}.views: at least two frames are needed to track")
     mode = _mode(d, cameras, where)
+    moving = [p if len(p) > 1 else None for p in paths]
+    for i, p in enumerate(moving):
+        at = f"{where}.views[{i}].camera"
+        if p is not None and len(p) != len(images[i]):
+            raise JobError(f"{at}: its R and t are given on {len(p)} frames, its footage has "
+                           f"{len(images[i])}: one per frame, or one for a camera that stands "
+                           "still")
+        if p is not None and mode != CALIBRATED:
+            raise JobError(f"{at}: a camera that moves needs \"mode\": \"calibrated\" (the "
+                           "body's root is tracked in the world)")
     settings = _settings(d.get("settings"), f"{where}.settings")
     ft = d.get("frame_time", bvh.frame_time)
     if not isinstance(ft, (int, float)) or ft <= 0:
@@ -406,7 +443,7 @@ def load_job(path: str | Path) -> Job:
     _in_front(pose, sk, f"{where}.initial")
     corrections = _corrections(d.get("corrections", []), sk, bvh, bvh_path, base, cameras,
                                len(images[0]), f"{where}.corrections")
-    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections)
+    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections, moving)
 
 
 @dataclass
@@ -431,7 +468,8 @@ def load_fit(path: str | Path) -> FitJob:
     d = _read_json(path, "fit file")
     base, where = path.parent, path.name
     sk, bvh, _, init_bvh, frame = _body(d, base, where)
-    views, cameras, dists = _views(d, base, where)
+    views, paths, dists = _views(d, base, where)
+    cameras = [p[0] for p in paths]  # the clicks are on the first frame
     clicks_in = _field(d, "clicks", where, list)
     if len(clicks_in) != len(views):
         raise JobError(f"{where}.clicks: expected one object per view ({len(views)}), got "

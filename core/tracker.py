@@ -6,7 +6,9 @@ then fitted to the frame. The first frame's pose is the user's and the first key
 frame the user corrected takes the user's pose and becomes the key frame after it. Where
 every view looks along one line the body is tracked side-on (``core.side_on``), decided
 from the first pose. A frame whose residual jumps, whose body leaves the images or whose
-system is degenerate is reported as diverged instead of being accepted.
+system is degenerate is reported as diverged instead of being accepted. A camera that moves
+(a pan, a handheld phone solved in Blender) is given per frame; each frame is seen through
+its cameras as they stood then, and the root's motion stays the body's own, in the world.
 """
 
 from __future__ import annotations
@@ -19,11 +21,12 @@ import numpy as np
 from . import image as imagelib
 from . import se3
 from .blas import one_blas_thread
+from .camera import Camera
 from .confidence import UNSEEN
 from .errors import InputError
 from .frame_fit import FrameFit, FrameResult
 from .linearize import Kinematics
-from .pose import INDEPENDENT, BodyPose, extrapolate
+from .pose import CALIBRATED, INDEPENDENT, BodyPose, extrapolate
 from .settings import TrackerSettings
 from .side_on import depth_blind_joints, side_on_skeleton
 from .skeleton import Skeleton
@@ -66,9 +69,28 @@ class Tracker(FrameFit):
     over a sequence."""
 
     def __init__(self, skeleton: Skeleton, images: Sequence[Sequence], mode: str = INDEPENDENT,
-                 settings: TrackerSettings | None = None):
+                 settings: TrackerSettings | None = None,
+                 moving: Sequence[Sequence[Camera] | None] | None = None):
+        """``moving``: per view, its camera on every frame where the camera moves (None for
+        a view whose camera stands still); calibrated mode only."""
         super().__init__(skeleton, images, mode, settings)
         self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
+        self.moving = list(moving) if moving is not None else [None] * self.seq.n_views
+        if any(m is not None for m in self.moving) and mode != CALIBRATED:
+            raise InputError("cameras that move need the calibrated mode: the body's root is "
+                             "tracked in the world, each camera is where it was filmed from")
+        for c, path in enumerate(self.moving):
+            if path is not None and len(path) < self.seq.n_frames():
+                raise InputError(f"view {c + 1}'s camera is given on {len(path)} frames, its "
+                                 f"footage has {self.seq.n_frames()}")
+
+    def _filmed_from(self, pose: BodyPose, frame: int) -> BodyPose:
+        """``pose`` seen through each view's camera as it stood on ``frame``."""
+        if all(m is None for m in self.moving):
+            return pose
+        out = pose.copy()
+        out.views = [v if m is None else m[frame].copy() for v, m in zip(pose.views, self.moving)]
+        return out
 
     def _check_start(self, initial: BodyPose, frame: int) -> None:
         """InputError unless every view's image files can be read and share one size, that
@@ -133,6 +155,7 @@ class Tracker(FrameFit):
             raise InputError(
                 f"the pose has {len(initial.views)} views, the footage {self.seq.n_views}"
             )
+        initial = self._filmed_from(initial, frames[0])
         self._check_start(initial, frames[0])
         key_frame, key = frames[0], initial
         self.key_sets.clear()  # the key pose may differ from an earlier run's
@@ -161,7 +184,7 @@ class Tracker(FrameFit):
                 self.seq.read_ahead(frames[i + 1])
             prev = history[-1]
             if frame in corrections:
-                key_frame, key = frame, corrections[frame].copy()
+                key_frame, key = frame, self._filmed_from(corrections[frame], frame).copy()
                 self.key_sets.clear()
                 res = FrameResult(frame=frame, pose=key.copy(), residual=0.0, iterations=0,
                                   converged=True, given=True)
@@ -172,8 +195,9 @@ class Tracker(FrameFit):
                 history = history[-1:] + [res] if prev.given else [res]
                 continue
             unseen = [n for n, why in prev.flagged.items() if why == UNSEEN]
-            pred = (self.predict(history[-2].pose, prev.pose, unseen) if len(history) >= 2
-                    else prev.pose.copy())
+            pred = self._filmed_from(
+                self.predict(history[-2].pose, prev.pose, unseen) if len(history) >= 2
+                else prev.pose.copy(), frame)
             try:
                 with one_blas_thread():
                     res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)

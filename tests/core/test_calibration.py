@@ -114,11 +114,11 @@ def test_the_command_line_writes_cameras_a_job_takes_by_name(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "4 cameras" in proc.stderr and "cam03: 1088x1920" in proc.stderr
     direct = read_calibration(DATA / "Calib.qca.txt")
-    cam, dist = parse_camera({"calibration": "cameras.json", "name": "cam03"}, "cam", tmp_path)
+    (cam,), dist = parse_camera({"calibration": "cameras.json", "name": "cam03"}, "cam", tmp_path)
     np.testing.assert_allclose(cam.K, direct[2].camera.K)
     np.testing.assert_allclose(cam.R, direct[2].camera.R)
     np.testing.assert_allclose(dist, direct[2].dist)
-    cam, _ = parse_camera({"calibration": str(DATA / "Calib.qca.txt"), "name": "cam01",
+    (cam,), _ = parse_camera({"calibration": str(DATA / "Calib.qca.txt"), "name": "cam01",
                            "scale": 100}, "cam", tmp_path)
     np.testing.assert_allclose(cam.t, 100 * direct[0].camera.t)
     with pytest.raises(JobError, match=r"cam.name: 'cameras.json' holds 4 cameras \(cam01, "):

@@ -290,7 +290,7 @@ def test_a_tracked_joint_with_nothing_away_from_it_is_refused(footage, tmp_path)
 
 
 def test_camera_parsing_maps_world_points_as_documented():
-    view, dist = parse_camera(CAMERA, "cam")
+    (view,), dist = parse_camera(CAMERA, "cam")
     assert dist is None
     X = np.array([0.2, 1.0, -0.4])
     R, t = np.array(CAMERA["R"], float), np.array(CAMERA["t"])
@@ -435,3 +435,67 @@ def test_malformed_pinhole_cameras_get_one_clear_error(pinhole_footage, change, 
             load_job(path)
     finally:
         path.write_text(good)
+
+
+def test_a_camera_that_pans_is_followed_frame_by_frame(pinhole_footage, tmp_path):
+    """The first view's camera pans 4 degrees a frame about its own vertical axis: given its
+    R and t on every frame the walk tracks as from still cameras; the same footage told the
+    camera stood still does not."""
+    src_folder, src_job = pinhole_footage
+    folder = tmp_path / "pan"
+    folder.mkdir()
+    (folder / "walk.bvh").write_bytes((src_folder / "walk.bvh").read_bytes())
+    still = _pinhole(CAMERA)
+    R0, t0 = np.array(still["R"], float), np.array(still["t"], float)
+    centre = -R0.T @ t0
+    Rs = [se3.exp_so3(np.radians([0, 4.0 * f, 0])) @ R0 for f in range(3)]
+    pan = dict(still, R=[R.tolist() for R in Rs], t=[(-R @ centre).tolist() for R in Rs])
+    views = [dict(v, camera=c) for v, c in zip(src_job["views"], [pan, _pinhole(FRONT),
+                                                                   _pinhole(OBLIQUE)])]
+    job = dict(src_job, views=views)
+    for v in ("side", "front", "oblique"):
+        (folder / v).mkdir()
+        for f in range(3):
+            cv2.imwrite(str(folder / v / f"{f:03d}.png"), np.zeros((4, 4), np.uint8))
+    (folder / "job.json").write_text(json.dumps(job))
+    loaded = load_job(folder / "job.json")
+    assert loaded.moving[0] is not None and loaded.moving[1] is None
+    R, p = read_bvh(folder / "walk.bvh").poses()
+    for c, v in enumerate(["side", "front", "oblique"]):
+        for f in range(3):
+            cams = [loaded.moving[0][f]] + loaded.cameras[1:]
+            img = render(loaded.skeleton, BodyPose(R[f], p[f], cams), c, shape=(300, 320),
+                         noise=0.01, seed=f)
+            cv2.imwrite(str(folder / v / f"{f:03d}.png"), (img * 255).astype(np.uint8))
+    errors = {}
+    for name, cam in (("panning", pan), ("told_still", dict(pan, R=pan["R"][0], t=pan["t"][0]))):
+        (folder / f"{name}.json").write_text(json.dumps(dict(job, views=[
+            dict(views[0], camera=cam)] + views[1:])))
+        out = tmp_path / f"{name}.bvh"
+        proc = _run("track", folder / f"{name}.json", "--out", out)
+        assert proc.returncode in (0, 3), proc.stderr
+        R_got, p_got = read_bvh(out).poses()
+        sk = loaded.skeleton
+        worst = 0.0
+        for f in range(len(R_got)):
+            X, Y = sk.world_positions(R_got[f], p_got[f]), sk.world_positions(R[f], p[f])
+            for a, b in [("LeftHip", "LeftKnee"), ("LeftKnee", "LeftAnkle"),
+                         ("RightHip", "RightKnee"), ("RightKnee", "RightAnkle")]:
+                ja, jb = sk.index(a), sk.index(b)
+                err = se3.angle_between_vectors(X[jb] - X[ja], Y[jb] - Y[ja])
+                worst = max(worst, float(np.degrees(err)))
+            worst = max(worst, 100 * float(np.linalg.norm(p_got[f] - p[f])))  # 1 cm ~ 1 deg
+        errors[name] = worst
+    assert errors["panning"] < 2.0
+    assert errors["told_still"] > 2 * errors["panning"] + 2.0, errors
+    ortho_pan = dict(CAMERA, R=[R.tolist() for R in Rs], t=[CAMERA["t"]] * 3)
+    bad = dict(job, mode="independent", views=[dict(views[0], camera=ortho_pan)] + [
+        dict(v, camera=c) for v, c in zip(views[1:], (FRONT, OBLIQUE))])
+    (folder / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(JobError, match=r"views\[0\].camera: a camera that moves needs"):
+        load_job(folder / "bad.json")
+    short = dict(job, views=[dict(views[0], camera=dict(pan, R=pan["R"][:2], t=pan["t"][:2]))]
+                 + views[1:])
+    (folder / "short.json").write_text(json.dumps(short))
+    with pytest.raises(JobError, match="given on 2 frames, its footage has 3"):
+        load_job(folder / "short.json")
