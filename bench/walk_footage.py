@@ -29,6 +29,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from core import se3  # noqa: E402
 from core.bvh import read_bvh, write_bvh  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
@@ -120,16 +121,25 @@ def camera_rotations() -> dict[str, np.ndarray]:
     }
 
 
-def job_camera(R: np.ndarray, zoom: int = 1) -> dict:
-    """The job's camera dict: pixel = s (R X + t)[:2] + center, with STAGE_CENTRE mid-image
-    (footage ``zoom`` times the size: the same stage in more pixels)."""
-    return {
-        "model": "scaled_orthographic",
-        "R": R.tolist(),
-        "t": (-R @ STAGE_CENTRE).tolist(),
-        "scale": PIXELS_PER_METRE * zoom,
-        "center": [WIDTH * zoom / 2 - 0.5, HEIGHT * zoom / 2 - 0.5],
-    }
+def job_camera(R: np.ndarray, zoom: int = 1, distance: float | None = None,
+               pans: list[float] | None = None) -> dict:
+    """The job's camera dict, with STAGE_CENTRE mid-image (footage ``zoom`` times the size:
+    the same stage in more pixels): scaled orthographic, pixel = s (R X + t)[:2] + center;
+    or, ``distance`` metres from the centre, a pinhole as ``add_camera`` makes it, turned
+    by ``pans`` (degrees, one per frame: R and t given per frame) where it pans."""
+    center = [WIDTH * zoom / 2 - 0.5, HEIGHT * zoom / 2 - 0.5]
+    if distance is None:
+        return {"model": "scaled_orthographic", "R": R.tolist(),
+                "t": (-R @ STAGE_CENTRE).tolist(), "scale": PIXELS_PER_METRE * zoom,
+                "center": center}
+    f = PIXELS_PER_METRE * zoom * distance
+    position = STAGE_CENTRE - distance * R[2]
+    K = [[f, 0.0, center[0]], [0.0, f, center[1]], [0.0, 0.0, 1.0]]
+    if pans is None:
+        return {"model": "pinhole", "K": K, "R": R.tolist(), "t": (-R @ position).tolist()}
+    Rs = [panned(R, a) for a in pans]
+    return {"model": "pinhole", "K": K, "R": [r.tolist() for r in Rs],
+            "t": [(-r @ position).tolist() for r in Rs]}
 
 
 def cloth_colour(P: np.ndarray, seed: int = 7) -> np.ndarray:
@@ -254,55 +264,77 @@ def build_scene(bpy, bvh_path: Path, zoom: int = 1, radii: dict = RADII,
 
 
 def add_camera(bpy, name: str, R: np.ndarray, centre: np.ndarray = STAGE_CENTRE,
-               metres_across: float = WIDTH / PIXELS_PER_METRE):
-    """An orthographic camera with world-to-camera rotation ``R`` looking at ``centre``
-    and ``metres_across`` wide."""
-    from mathutils import Matrix
-
+               metres_across: float = WIDTH / PIXELS_PER_METRE, distance: float | None = None):
+    """A camera with world-to-camera rotation ``R`` looking at ``centre`` and showing
+    ``metres_across`` across there: orthographic (``distance`` None) or perspective,
+    ``distance`` metres from ``centre``."""
     cam_data = bpy.data.cameras.new(name)
-    cam_data.type = "ORTHO"
+    cam_data.type = "ORTHO" if distance is None else "PERSP"
     cam_data.ortho_scale = metres_across
+    if distance is not None:  # the focal length that shows the centre's depth that wide
+        cam_data.sensor_fit = "HORIZONTAL"
+        cam_data.lens = cam_data.sensor_width * distance / metres_across
     cam_data.clip_start, cam_data.clip_end = 0.01, 100.0
     cam = bpy.data.objects.new(name, cam_data)
     bpy.context.collection.objects.link(cam)
-    # Blender's camera looks down its local -z with +y up: columns x, -y, -z of ours
-    rot = R.T @ np.diag([1.0, -1.0, -1.0])
-    M = np.eye(4)
-    M[:3, :3] = rot
-    M[:3, 3] = centre - 10.0 * R[2]  # 10 m back along the viewing direction
-    cam.matrix_world = Matrix(M.tolist())
+    place_camera(cam, R, centre - (10.0 if distance is None else distance) * R[2])
     return cam
 
 
-def render(out: Path, first: int, last: int, step: int, views: list[str], zoom: int = 1
-           ) -> dict:
+def place_camera(cam, R: np.ndarray, position: np.ndarray) -> None:
+    """Put ``cam`` at ``position`` with world-to-camera rotation ``R`` (rows: image x, image
+    y down, viewing direction)."""
+    from mathutils import Matrix
+
+    # Blender's camera looks down its local -z with +y up: columns x, -y, -z of ours
+    M = np.eye(4)
+    M[:3, :3] = R.T @ np.diag([1.0, -1.0, -1.0])
+    M[:3, 3] = position
+    cam.matrix_world = Matrix(M.tolist())
+
+
+def panned(R: np.ndarray, degrees: float) -> np.ndarray:
+    """The rotation ``R`` of a camera turned ``degrees`` about its own image's vertical (a
+    pan: positive turns the view to the image's right)."""
+    return R @ se3.exp_so3(np.radians(degrees) * R[1]).T
+
+
+def render(out: Path, first: int, last: int, step: int, views: list[str], zoom: int = 1,
+           distance: float | None = None, pan: float = 0.0) -> dict:
     """Render the capture's frames first..last (every ``step``-th) in each view into OUT
     (``zoom`` times WIDTH x HEIGHT, the same stage), keeping frames already rendered with
-    the same settings; returns the frames, the job cameras and how many were rendered."""
+    the same settings; returns the frames, the job cameras and how many were rendered.
+    Cameras are orthographic, or perspective ``distance`` metres from the stage's centre;
+    the first view's camera pans ``pan`` degrees a frame (``panned``)."""
     import bpy
     import cv2
 
     out.mkdir(parents=True, exist_ok=True)
     frames = list(range(first, last + 1, step))
     meta = {"bvh": str(CMU_WALK), "frames": frames, "width": WIDTH * zoom,
-            "height": HEIGHT * zoom,
-            "noise": NOISE_SIGMA, "version": 2}
+            "height": HEIGHT * zoom, "noise": NOISE_SIGMA, "version": 2,
+            "filming": [distance, pan]}
     stamp = out / "footage.json"
     rots = camera_rotations()
+    pans = {v: [pan * k for k in range(len(frames))] if pan and v == views[0] else None
+            for v in views}
     todo = [(v, f) for v in views for f in frames
             if not (out / v / f"{f:04d}.png").is_file()]
     old = json.loads(stamp.read_text()) if stamp.is_file() else None
-    if old and {k: old[k] for k in ("width", "height", "noise", "version")} != {
-            k: meta[k] for k in ("width", "height", "noise", "version")}:
+    kept = ("width", "height", "noise", "version", "filming")
+    if old and {k: old.get(k) for k in kept} != {k: meta[k] for k in kept}:
         todo = [(v, f) for v in views for f in frames]
     if todo:
         arm, _ = build_scene(bpy, CMU_WALK, zoom)
         scene = bpy.context.scene
-        cams = {v: add_camera(bpy, v, rots[v]) for v in views}
+        cams = {v: add_camera(bpy, v, rots[v], distance=distance) for v in views}
         rng = np.random.default_rng(first * 7919 + last)
         for v, f in todo:
             (out / v).mkdir(exist_ok=True)
             scene.camera = cams[v]
+            if pans[v]:
+                place_camera(cams[v], panned(rots[v], pans[v][frames.index(f)]),
+                             STAGE_CENTRE - distance * rots[v][2])
             scene.frame_set(f + 1)  # the importer puts BVH frame 0 on Blender frame 1
             path = out / v / f"{f:04d}.png"
             scene.render.filepath = str(path)
@@ -317,17 +349,18 @@ def render(out: Path, first: int, last: int, step: int, views: list[str], zoom: 
     truth.motion = truth.motion[frames]
     truth.frame_time *= step
     write_bvh(truth, out / "truth.bvh")
-    cams_json = {v: job_camera(rots[v], zoom) for v in views}
+    cams_json = {v: job_camera(rots[v], zoom, distance, pans[v]) for v in views}
     (out / "cameras.json").write_text(json.dumps(cams_json, indent=1))
     return {"frames": frames, "cameras": cams_json, "rendered": len(todo)}
 
 
 def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images: str = "*.png",
-                   joints: dict = JOINTS):
+                   joints: dict = JOINTS, distance: float | None = None, pan: float = 0.0):
     """Make the current scene ready to track rendered walk footage in ``folder``: the capture
     (folder/truth.bvh) imported as an armature and posed on frame 1, the bones of ``joints``
     unlocked (as balls: Blender's bone axes are not the capture's hinge axes), envelope radii
-    from BLOBS, one orthographic camera and view per rendered view, frames 1..last_frame.
+    from BLOBS, one camera and view per rendered view (as ``render`` filmed them, the first
+    one's pan keyed on every frame), frames 1..last_frame.
     Needs the add-on registered; resetting the scene is the caller's (a factory reset disables
     an installed extension)."""
     bpy.ops.import_anim.bvh(filepath=str(folder / "truth.bvh"), axis_forward="Y", axis_up="Z",
@@ -349,8 +382,12 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
     scene.frame_start, scene.frame_end = 1, last_frame
     scene.twist.armature = arm
     rotations = camera_rotations()
-    for v in views:
-        cam = add_camera(bpy, v, rotations[v])
+    for i, v in enumerate(views):
+        cam = add_camera(bpy, v, rotations[v], distance=distance)
+        for k in range(last_frame if pan and i == 0 else 0):
+            place_camera(cam, panned(rotations[v], pan * k),
+                         STAGE_CENTRE - distance * rotations[v][2])
+            cam.keyframe_insert("rotation_euler", frame=k + 1)
         view = scene.twist.views.add()
         view.camera, view.images, view.first_frame = cam, str(folder / v / images), 1
     scene.frame_set(1)

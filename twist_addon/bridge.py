@@ -20,8 +20,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import se3
-from ..core.camera import View
+from ..core.camera import Camera, Pinhole, View
 from ..core.errors import InputError
+from ..core.pose import CALIBRATED
 from ..core.skeleton import BALL, FIXED, HINGE, Skeleton, bone_blob
 
 
@@ -149,30 +150,77 @@ def set_pose(arm, sk: Skeleton, R: np.ndarray, root_position: np.ndarray) -> Non
     arm.pose.bones[sk.names[0]].location = loc
 
 
-def view_from_camera(cam, scene) -> View:
-    """The scaled orthographic view of an orthographic camera at the scene's resolution."""
+def view_from_camera(cam, scene) -> Camera:
+    """The camera as the tracker sees it, at the scene's resolution and current frame: an
+    orthographic camera as a scaled orthographic view, a perspective one as a pinhole (its
+    focal length, sensor fit and lens shift as Blender renders them)."""
     if cam.type != "CAMERA":
         raise BridgeError(f"'{cam.name}' is not a camera")
     data = cam.data
-    if data.type != "ORTHO":
-        kind = {"PERSP": "perspective", "PANO": "panoramic"}.get(data.type, data.type.lower())
+    if data.type not in ("ORTHO", "PERSP"):
+        kind = {"PANO": "panoramic"}.get(data.type, data.type.lower())
         raise BridgeError(f"the camera '{cam.name}' is {kind}; the tracker needs an "
-                          "orthographic camera (Camera properties > Lens > Type)")
+                          "orthographic or perspective camera (Camera properties > Lens > Type)")
     r = scene.render
     W = r.resolution_x * r.resolution_percentage / 100
     H = r.resolution_y * r.resolution_percentage / 100
     if r.pixel_aspect_x != r.pixel_aspect_y:
         raise BridgeError("the scene's pixels are not square (Output > Format > Aspect)")
     fit = data.sensor_fit
-    span = W if fit == "HORIZONTAL" or fit == "AUTO" and W >= H else H
-    s = span / data.ortho_scale
+    horizontal = fit == "HORIZONTAL" or fit == "AUTO" and W >= H
+    span = W if horizontal else H  # the image side the sensor (or ortho scale) spans
     M = _matrix(cam.matrix_world)
     axes = M[:3, :3] / np.linalg.norm(M[:3, :3], axis=0)
     R = np.stack([axes[:, 0], -axes[:, 1], -axes[:, 2]])  # x right, y down, z forward
     t = -R @ M[:3, 3]
     # shifting the lens right moves the picture left (and up moves it down)
     center = np.array([(W - 1) / 2 - data.shift_x * span, (H - 1) / 2 + data.shift_y * span])
-    return View(se3.Similarity(s, R, t), center)
+    if data.type == "ORTHO":
+        return View(se3.Similarity(span / data.ortho_scale, R, t), center)
+    sensor = data.sensor_height if fit == "VERTICAL" else data.sensor_width
+    f = data.lens / sensor * span
+    return Pinhole(np.array([[f, 0.0, center[0]], [0.0, f, center[1]], [0.0, 0.0, 1.0]]), R, t)
+
+
+def _animated(obj) -> bool:
+    """Whether anything can move ``obj`` or change its lens over the frames: its own or a
+    parent's animation, drivers or constraints, or its camera data's animation."""
+    data = getattr(obj, "data", None)
+    if data is not None and data.animation_data is not None:
+        return True
+    while obj is not None:
+        if obj.animation_data is not None or len(obj.constraints):
+            return True
+        obj = obj.parent
+    return False
+
+
+def camera_path(cam, scene, frames) -> list[Camera] | None:
+    """The camera on each of ``frames`` (scene frames, in that order) when it moves or zooms
+    over them, else None; the scene is left on the frame it was on."""
+    if not _animated(cam):
+        return None
+    cur = scene.frame_current
+    path = []
+    try:
+        for f in frames:
+            scene.frame_set(f)
+            path.append(view_from_camera(cam, scene))
+    finally:
+        scene.frame_set(cur)
+    numbers = [np.concatenate([c.K.ravel(), c.R.ravel(), c.t]) if c.central else
+               np.concatenate([c.pose.matrix().ravel(), c.center]) for c in path]
+    return path if any(not np.allclose(n, numbers[0]) for n in numbers) else None
+
+
+def tracking_mode(scene, views: list[Camera]) -> str:
+    """The core mode of the scene's *Views* setting; perspective cameras are calibrated only
+    (a BridgeError says so under *Independent*)."""
+    mode = scene.twist.mode.lower()
+    if mode != CALIBRATED and any(v.central for v in views):
+        raise BridgeError("perspective cameras are placed where they filmed from: set Views "
+                          "to Calibrated (or make the cameras orthographic)")
+    return mode
 
 
 # core templates are y up and face +z; Blender is z up and a character faces -y

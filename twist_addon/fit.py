@@ -22,6 +22,7 @@ from .bridge import (
     pose_from_armature,
     set_pose,
     skeleton_from_armature,
+    tracking_mode,
     view_from_camera,
 )
 from .markers import markers_at, set_marker
@@ -102,7 +103,7 @@ def fit_armature(scene, fit_lengths: bool = False) -> tuple[float, dict[str, flo
             if bone not in sk.names:
                 raise BridgeError(f"a marker names bone '{bone}', which '{arm.name}' lacks")
     R, root = pose_from_armature(arm, sk)
-    mode = tw.mode.lower()
+    mode = tracking_mode(scene, views)
     try:
         res = fit_pose(sk, BodyPose(R, root, views), clicks, mode, fit_lengths=fit_lengths)
     except FitError as e:

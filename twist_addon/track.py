@@ -13,15 +13,17 @@ import bpy
 
 from ..core.confidence import frame_list
 from ..core.frame_fit import FrameResult
-from ..core.pose import BodyPose, world_pose
+from ..core.pose import CALIBRATED, BodyPose, world_pose
 from ..core.tracker import Tracker, frames_to_check, frames_tracked
 from . import checks, keyframes
 from .armature_action import ArmatureAction
 from .bridge import (
     BridgeError,
+    camera_path,
     pose_from_armature,
     skeleton_from_armature,
     tracked_skeleton,
+    tracking_mode,
     view_from_camera,
 )
 from .errors import INPUT_ERRORS
@@ -59,16 +61,21 @@ class TrackSession:
             frames = list(range(cur, scene.frame_start - 1, -1))
         if len(frames) < 2:
             raise BridgeError(f"nothing to track {tw.direction.lower()} from frame {cur}")
-        views, images = [], []
+        views, images, moving = [], [], []
         for v in tw.views:
             if v.camera is None:
                 raise BridgeError("a view has no camera; pick its camera or remove the view")
             views.append(view_from_camera(v.camera, scene))
             images.append(footage_frames(v, frames))
+            moving.append(camera_path(v.camera, scene, frames))
+        mode = tracking_mode(scene, views)
+        if mode != CALIBRATED and any(m is not None for m in moving):
+            raise BridgeError("a view's camera moves over the frames: set Views to Calibrated "
+                              "(the body's root is then tracked in the world)")
         sk = tracked_skeleton(arm)
         settings = settings_from_properties(tw.tracker)
-        # the tracker indexes frames 0..n-1 in tracking order
-        tracker = Tracker(sk, images, tw.mode.lower(), settings)
+        # the tracker indexes frames 0..n-1 in tracking order, the cameras' paths too
+        tracker = Tracker(sk, images, mode, settings, moving)
         user_keys = keyframes.user_keys(arm, sk)
         corrections = {}
         for i, f in enumerate(frames[1:], 1):

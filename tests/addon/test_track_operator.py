@@ -35,6 +35,15 @@ def long_footage(tmp_path_factory):
     return folder
 
 
+@pytest.fixture(scope="module")
+def perspective_footage(tmp_path_factory):
+    """The walk of ``footage`` filmed by perspective cameras 3.5 m from the stage, the
+    lateral one panning 2 degrees a frame."""
+    folder = tmp_path_factory.mktemp("walk_perspective")
+    render(folder, 560, 580, 4, VIEWS, distance=3.5, pan=2.0)
+    return folder
+
+
 def _scene(bpy, addon, folder: Path, frames: int = 6):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     return tracking_scene(bpy, folder, VIEWS, frames)
@@ -80,6 +89,40 @@ def test_track_keys_exactly_the_tracked_bones_and_frames(bpy_module, registered,
             ga, gb = got[sk.index(a)], got[sk.index(b)]
             err = np.degrees(se3.angle_between_vectors(gb - ga, want[b] - want[a]))
             assert err < 8.0, (f, a, err)  # measured: at most 6.1 (knees as balls here)
+
+
+def test_perspective_cameras_one_panning_track_through_the_operators(bpy_module, registered,
+                                                                    perspective_footage):
+    """Three perspective cameras as Blender's, the lateral one's pan keyed on every frame:
+    Track reads each camera as it stood on each frame and the legs follow the capture as
+    closely as through orthographic cameras."""
+    bpy = bpy_module
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene, arm = tracking_scene(bpy, perspective_footage, VIEWS, 6, distance=3.5, pan=2.0)
+    bridge = registered.twist_addon.bridge
+    cams = [v.camera for v in scene.twist.views]
+    assert all(c.data.type == "PERSP" for c in cams)
+    frames = list(range(1, 7))
+    path = bridge.camera_path(cams[0], scene, frames)
+    assert path is not None and [bridge.camera_path(c, scene, frames) for c in cams[1:]] == [
+        None, None]
+    turn = np.degrees(se3.angle_between_vectors(path[0].R[2], path[-1].R[2]))
+    assert turn == pytest.approx(10.0, abs=0.01) and scene.frame_current == 1
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    assert scene.twist.result.frames_tracked == 5
+    sk = bridge.skeleton_from_armature(arm)
+    truth = read_bvh(perspective_footage / "truth.bvh")
+    R_true, p_true = truth.poses()
+    for f in range(2, 7):
+        scene.frame_set(f)
+        R, p = bridge.pose_from_armature(arm, sk)
+        got = sk.world_positions(R, p)
+        want = dict(zip(truth.names, _bvh_world(truth, R_true[f - 1], p_true[f - 1])))
+        for a, b in [("LeftHip", "LeftKnee"), ("RightHip", "RightKnee"),
+                     ("LeftKnee", "LeftAnkle"), ("RightKnee", "RightAnkle")]:
+            ga, gb = got[sk.index(a)], got[sk.index(b)]
+            err = np.degrees(se3.angle_between_vectors(gb - ga, want[b] - want[a]))
+            assert err < 8.0, (f, a, err)
 
 
 def test_one_view_tracks_and_notes_the_joints_it_cannot_see_turn_in_depth(bpy_module,
@@ -285,8 +328,11 @@ def test_clear_removes_only_what_tracking_wrote(bpy_module, registered, footage)
 
 
 @pytest.mark.parametrize("breakage, message", [
-    (lambda s, a: setattr(s.twist.views[0].camera.data, "type", "PERSP"),
-     "'lateral' is perspective"),
+    (lambda s, a: setattr(s.twist.views[0].camera.data, "type", "PANO"),
+     "'lateral' is panoramic"),
+    (lambda s, a: (setattr(s.twist.views[0].camera.data, "type", "PERSP"),
+                   setattr(s.twist, "mode", "INDEPENDENT")),
+     "perspective cameras are placed where they filmed from: set Views to Calibrated"),
     (lambda s, a: setattr(s.twist.views[1], "images", ""), "the view of 'endon' has no footage"),
     (lambda s, a: setattr(s, "frame_end", 9), "no image for frame 7"),
     (lambda s, a: [setattr(pb, "lock_rotation", (True,) * 3) for pb in a.pose.bones],
