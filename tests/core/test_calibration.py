@@ -14,7 +14,7 @@ from core import se3
 from core.calibration import CalibrationError, read_calibration
 from core.job import JobError, parse_camera
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "pose2sim"
+DATA = Path(__file__).resolve().parents[2] / "bench" / "data" / "pose2sim"
 ROOT = Path(__file__).resolve().parents[2]
 
 
