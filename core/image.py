@@ -23,6 +23,9 @@ from .errors import InputError
 _REMAP_COLS = 16384
 
 
+IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".exr", ".webp"}
+
+
 class ImageError(InputError):
     """An image that cannot be read; the message names the file."""
 

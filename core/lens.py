@@ -20,12 +20,16 @@ from . import image as imagelib
 
 class Undistorted(Sequence):
     """A view's frames (image paths, arrays or a movie's frames) read undistorted: item i is
-    frame i as the ideal pinhole K sees it, a grey float32 image in [0, 1]."""
+    frame i as the ideal pinhole K sees it, a grey float32 image in [0, 1], on the frames'
+    own pixel grid or on one ``size`` = (width, height) (the calibration's, where the footage
+    was cropped)."""
 
-    def __init__(self, source: Sequence, K: np.ndarray, dist: np.ndarray):
+    def __init__(self, source: Sequence, K: np.ndarray, dist: np.ndarray,
+                 size: tuple[int, int] | None = None):
         self.source = source  # the frames as filmed
         self.K = np.asarray(K, dtype=float)
         self.dist = np.asarray(dist, dtype=float)
+        self.size = size
         self._maps: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}  # by (H, W)
 
     def __len__(self) -> int:
@@ -35,12 +39,17 @@ class Undistorted(Sequence):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
         src = self.source[i]
-        grey = imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
-        size = grey.shape[:2]
-        if size not in self._maps:
-            self._maps[size] = cv2.initUndistortRectifyMap(
-                self.K, self.dist, None, self.K, (size[1], size[0]), cv2.CV_32FC1)
-        return cv2.remap(grey, *self._maps[size], cv2.INTER_LINEAR,
+        return self.remap(imagelib.to_grey(src) if isinstance(src, np.ndarray)
+                          else imagelib.load_grey(src))
+
+    def remap(self, img: np.ndarray) -> np.ndarray:
+        """An image (grey or colour) of the footage as filmed, undistorted."""
+        shape = img.shape[:2]
+        if shape not in self._maps:
+            size = self.size or (shape[1], shape[0])
+            self._maps[shape] = cv2.initUndistortRectifyMap(
+                self.K, self.dist, None, self.K, size, cv2.CV_32FC1)
+        return cv2.remap(img, *self._maps[shape], cv2.INTER_LINEAR,
                          borderMode=cv2.BORDER_REPLICATE)
 
 

@@ -182,6 +182,26 @@ def view_from_camera(cam, scene) -> Camera:
     return Pinhole(np.array([[f, 0.0, center[0]], [0.0, f, center[1]], [0.0, 0.0, 1.0]]), R, t)
 
 
+def place_pinhole(cam, pinhole: Pinhole, size: tuple[int, int]) -> None:
+    """Make the camera object ``cam`` the perspective camera ``pinhole`` is for images of
+    ``size`` = (width, height) (the inverse of ``view_from_camera``, which the scene's
+    resolution must then match): its sensor fitted horizontally, the focal length and lens
+    shift in its terms, placed and turned in the world."""
+    from mathutils import Matrix
+
+    W, _ = size
+    K = pinhole.K
+    data = cam.data
+    data.type, data.sensor_fit = "PERSP", "HORIZONTAL"
+    data.lens = K[0, 0] * data.sensor_width / W  # Blender's pixels are square: fx
+    data.shift_x = ((W - 1) / 2 - K[0, 2]) / W
+    data.shift_y = (K[1, 2] - (size[1] - 1) / 2) / W
+    M = np.eye(4)
+    M[:3, :3] = pinhole.R.T @ np.diag([1.0, -1.0, -1.0])  # Blender's camera: x, y up, -z
+    M[:3, 3] = pinhole.centre
+    cam.matrix_world = Matrix(M.tolist())
+
+
 def _animated(obj) -> bool:
     """Whether anything can move ``obj`` or change its lens over the frames: its own or a
     parent's animation, drivers or constraints, or its camera data's animation."""

@@ -53,6 +53,7 @@ class TWIST_PT_views(_TwistPanel, bpy.types.Panel):
         col.operator("twist.remove_view", icon="REMOVE", text="")
         col.separator()
         col.operator("twist.add_plate_view", icon="IMAGE_DATA", text="")
+        col.operator("twist.add_calibrated_views", icon="OUTLINER_OB_CAMERA", text="")
         if tw.views:
             view = tw.views[tw.active_view]
             layout.prop(view, "first_frame")

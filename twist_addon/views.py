@@ -2,7 +2,7 @@
 image for each scene frame.
 
 Operator ids are a public contract: ``twist.add_view``, ``twist.add_plate_view``,
-``twist.remove_view``."""
+``twist.add_calibrated_views``, ``twist.remove_view``."""
 
 from __future__ import annotations
 
@@ -10,11 +10,15 @@ import glob
 from pathlib import Path
 
 import bpy
+import cv2
 
+from ..core.calibration import read_calibration
 from ..core.errors import InputError
+from ..core.image import IMAGE_SUFFIXES
+from ..core.lens import Undistorted
 from ..core.plate import write_frames
 from ..core.video import VideoFrames, is_video
-from .bridge import BridgeError
+from .bridge import BridgeError, place_pinhole
 from .properties import first_frame_property
 
 
@@ -174,6 +178,106 @@ class TWIST_OT_add_plate_view(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _camera_footage(folder: Path, name: str) -> Path:
+    """The footage of the calibration's camera ``name`` beside it: a movie ``name.*``, or
+    the first image of a folder ``name/``; BridgeError saying where to put it."""
+    movies = sorted(p for p in folder.glob(f"{glob.escape(name)}.*") if is_video(p))
+    if movies:
+        return movies[0]
+    frames = sorted(p for p in (folder / name).glob("*") if p.suffix.lower() in IMAGE_SUFFIXES) \
+        if (folder / name).is_dir() else []
+    if frames:
+        return frames[0]
+    raise BridgeError(f"no footage for the camera '{name}': put its movie ({name}.mp4, ...) or "
+                      f"its frames (a folder {name}/) beside the calibration, in {folder}")
+
+
+def _undistorted_footage(path: Path, cam, out: Path) -> Path:
+    """The footage ``path`` (a movie, or an image of a sequence) undistorted through the
+    camera's lens into ``out`` as PNG frames on the calibration's pixel grid; the first
+    frame's path."""
+    frames = VideoFrames(path) if is_video(path) else sorted(path.parent.glob(f"*{path.suffix}"))
+    lens = Undistorted([], cam.camera.K, cam.dist, cam.size)
+    out.mkdir(exist_ok=True)
+    for old in out.glob("*.png"):
+        old.unlink()
+    for i in range(len(frames)):
+        img = frames[i] if is_video(path) else cv2.imread(str(frames[i]), cv2.IMREAD_UNCHANGED)
+        if img is None:
+            raise BridgeError(f"{frames[i]}: cannot read this image")
+        cv2.imwrite(str(out / f"{i + 1:04d}.png"), lens.remap(img))
+    return out / "0001.png"
+
+
+def add_calibrated_views(context, calibration: Path, first_frame: int) -> str:
+    """One view per camera of a calibration file (``core.calibration``), each a perspective
+    camera placed and lensed as calibrated, with its footage found beside the file
+    (``_camera_footage``) and, through a distorting lens, undistorted into a folder
+    ``<camera>_undistorted`` there first. The scene takes the calibration's resolution and
+    the calibrated mode. Everything is checked before anything is added."""
+    try:
+        cams = read_calibration(calibration)
+    except InputError as e:
+        raise BridgeError(str(e)) from None
+    sizes = {c.size for c in cams}
+    if None in sizes or len(sizes) > 1:
+        raise BridgeError(f"{calibration.name}: its cameras' image sizes are "
+                          f"{', '.join(str(c.size) for c in cams)}; a scene renders every "
+                          "camera at one resolution, so one size given for all is needed")
+    folder = calibration.parent
+    sources = [_camera_footage(folder, c.name) for c in cams]
+    scene = context.scene
+    for cam, source in zip(cams, sources):
+        if cam.dist is not None:
+            source = _undistorted_footage(source, cam, folder / f"{cam.name}_undistorted")
+        add_footage_view(context, source, first_frame)
+        obj = scene.twist.views[-1].camera
+        obj.name = obj.data.name = cam.name
+        place_pinhole(obj, cam.camera, cam.size)
+    scene.render.resolution_x, scene.render.resolution_y = cams[0].size
+    scene.render.resolution_percentage = 100
+    scene.twist.mode = "CALIBRATED"
+    undistorted = sum(c.dist is not None for c in cams)
+    return (f"{calibration.name}: {len(cams)} calibrated views ({', '.join(c.name for c in cams)})"
+            + (f", {undistorted} with their footage undistorted beside it" if undistorted else "")
+            + f"; the scene is {cams[0].size[0]}x{cams[0].size[1]}, Calibrated")
+
+
+class TWIST_OT_add_calibrated_views(bpy.types.Operator):
+    """Add one view per camera of a calibration file (OpenCV, Pose2Sim, Qualisys): perspective
+    cameras placed as calibrated, each with its movie or frames folder named after it beside
+    the file (undistorted first where the lens distorts)"""
+
+    bl_idname = "twist.add_calibrated_views"
+    bl_label = "Add Views from Calibration"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: bpy.props.StringProperty(
+        name="Calibration", subtype="FILE_PATH",
+        description="OpenCV's .yml/.yaml/.xml/.json, Pose2Sim's .toml or Qualisys' .qca.txt; "
+                    "each camera's footage beside it, named after the camera")
+    first_frame: first_frame_property()
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        path = Path(bpy.path.abspath(self.filepath))
+        try:
+            message = add_calibrated_views(context, path, self.first_frame)
+        except BridgeError as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except OSError as e:
+            self.report({"ERROR"}, f"cannot write the undistorted footage beside {path.name} "
+                        f"({e.strerror}): copy the calibration and footage into a folder you "
+                        "can write to")
+            return {"CANCELLED"}
+        self.report({"INFO"}, message)
+        return {"FINISHED"}
+
+
 class TWIST_OT_remove_view(bpy.types.Operator):
     """Remove the selected view (its camera stays in the scene)"""
 
@@ -192,4 +296,5 @@ class TWIST_OT_remove_view(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (TWIST_OT_add_view, TWIST_OT_add_plate_view, TWIST_OT_remove_view)
+CLASSES = (TWIST_OT_add_view, TWIST_OT_add_plate_view, TWIST_OT_add_calibrated_views,
+           TWIST_OT_remove_view)

@@ -44,7 +44,7 @@ def test_panels_draw_existing_properties_and_operators(bpy_module, registered, t
     assert {"twist.track", "twist.clear_track", "twist.add_view", "twist.remove_view",
             "twist.add_template_armature", "twist.smooth_track", "twist.make_cycle",
             "twist.retarget", "twist.load_bone_map", "twist.edit_bone_map",
-            "twist.add_plate_view"} <= drawn_ops
+            "twist.add_plate_view", "twist.add_calibrated_views"} <= drawn_ops
 
 
 def test_add_and_remove_views(bpy_module, registered, tmp_path):
