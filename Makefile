@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test lint bench bench-quick bench-walk bench-plates extension clean
+.PHONY: venv demo test lint bench bench-quick bench-real bench-walk bench-plates extension clean
 
 venv: $(STAMP)
 
@@ -35,6 +35,11 @@ lint: venv
 # clips (never stored here) with BENCH_ARGS="--bandai-namco FOLDER".
 bench: venv
 	$(PY) bench/suite.py --write docs/BENCHMARK.md $(BENCH_ARGS)
+	$(PY) bench/real_clip.py --write docs/REAL_CLIP.md --sheet docs/real_clip_sheet.jpg
+
+# The real four-camera clip, tracked through its own calibration; writes docs/REAL_CLIP.md.
+bench-real: venv
+	$(PY) bench/real_clip.py --write docs/REAL_CLIP.md --sheet docs/real_clip_sheet.jpg
 
 # The suite's quick check for every change: the CMU clips at 15 fps.
 bench-quick: venv

@@ -90,13 +90,18 @@ def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:
 
 def image_error_px(sk: Skeleton, est: tuple, truth: tuple, views: list, limbs=LIMBS) -> float:
     """Mean distance (pixels) between tracked and true limb ends (the joints of ``limbs``)
-    as each of ``views`` (``core.camera.View``) shows them: how far the tracked body's
-    overlay strays from the body in the footage, which even one view sees."""
+    as each of ``views`` (a ``core.camera`` camera, or one per frame for a camera that
+    moves) shows them: how far the tracked body's overlay strays from the body in the
+    footage, which even one view sees."""
     F = min(len(est[0]), len(truth[0]))
-    pe, pt = (np.concatenate(list(limb_ends(sk, R[:F], p[:F], limbs).values()))
-              for R, p in (est, truth))
-    return float(np.mean([np.linalg.norm(v.project(pe) - v.project(pt), axis=1).mean()
-                          for v in views]))
+    pe, pt = (np.stack(list(limb_ends(sk, R[:F], p[:F], limbs).values()), 1)
+              for R, p in (est, truth))  # (F, ends, 3)
+    per_view = []
+    for v in views:
+        cams = v if isinstance(v, (list, tuple)) else [v] * F
+        per_view.append(np.mean([np.linalg.norm(c.project(a) - c.project(b), axis=1)
+                                 for c, a, b in zip(cams, pe, pt)]))
+    return float(np.mean(per_view))
 
 
 def _across(v: np.ndarray, sight: np.ndarray) -> np.ndarray:

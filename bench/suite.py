@@ -42,6 +42,7 @@ from suite_footage import (  # noqa: E402
     VIDEO_FPS,
     VIEWS,
     Clip,
+    look_cameras,
     render_look,
     stage,
 )
@@ -89,9 +90,12 @@ def write_job(clip_dir: Path, look: str, run: str, settings: dict) -> Path:
     truth = read_bvh(clip_dir / "truth.bvh")
     sk = skeleton_from_bvh(truth)
     R, _ = truth.poses()
-    cams = json.loads((clip_dir / "cameras.json").read_text())
+    cams = look_cameras(clip_dir, LOOKS[look])
     ext = "jpg" if LOOKS[look].jpeg else "png"
     frames = range(0, len(R), step)
+    for cam in cams.values():
+        if np.ndim(cam["R"]) == 3:  # a camera that moves: its pose on the run's frames
+            cam["R"], cam["t"] = cam["R"][::step], cam["t"][::step]
     job = {
         "skeleton": {"bvh": "truth.bvh",
                      "joints": Parts.of(sk.names).tracked_joints(sk, R, lower_back)},
@@ -176,7 +180,8 @@ def score_run(job_path: Path, run: str) -> dict:
            "peak_mb": peak_mb, "flags": flag_counts(rep, sk, est, truth, limbs)}
     if len(views) == 1:
         height_px = sk.height() * PIXELS_PER_METRE
-        px = evaluate.image_error_px(sk, est, truth, job.cameras, limbs)
+        px = evaluate.image_error_px(sk, est, truth, [m or c for c, m in zip(
+            job.cameras, job.moving)], limbs)
         row["image_pct"] = 100 * px / height_px
     return row
 

@@ -4,14 +4,17 @@ looks that vary what real footage varies.
 A look sets the body's cloth (its texture and its contrast with what is behind it), the
 backdrop (Muybridge's ruled black, a bright brick wall, a busy park-like scene), the light
 (soft studio, or hard sun casting the body's shadow on the wall beside it), motion blur
-(sub-frames averaged over half the frame interval), sensor noise and JPEG compression. The
-body is the same skinned capsule body as the walk benchmark's (``walk_footage``), sized by
-the capture's parts.
+(sub-frames averaged over half the frame interval), sensor noise and JPEG compression, and
+the lens: orthographic (a body far off), or perspective cameras a few metres away, the
+lateral one panning to keep the body mid-image (the ruled backdrop sliding past as it
+turns). The body is the same skinned capsule body as the walk benchmark's
+(``walk_footage``), sized by the capture's parts.
 
 Footage is rendered at 30 frames per second (15 fps runs take every other frame) into
 ``<clip folder>/<look folder>/<view>/NNNN.png|jpg`` (frames from 0), with ``truth.bvh``
-(the capture at 30 fps, in metres) and ``cameras.json`` in the clip's folder; footage
-already rendered with the same look and frames is kept.
+(the capture at 30 fps, in metres) and ``cameras.json`` (the orthographic cameras;
+``look_cameras`` makes a look's own) in the clip's folder; footage already rendered with
+the same look and frames is kept.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 from captures import Parts, normalized
-from walk_footage import RADII, add_camera, backdrop, build_scene, cloth_colour
+from walk_footage import RADII, add_camera, backdrop, build_scene, cloth_colour, place_camera
 
 from core.bvh import write_bvh
 from core.skeleton import skeleton_from_bvh
@@ -41,12 +44,16 @@ class Look:
     blur: int  # sub-frames averaged per frame (1: no motion blur)
     noise: float  # sensor noise, grey levels of 255
     jpeg: int  # JPEG quality (0: lossless PNG)
+    distance: float | None = None  # perspective cameras this far (m) from the stage's centre
+    pan: bool = False  # the lateral camera turns to keep the body's root mid-image
 
 
 LOOKS = {
     "muybridge": Look("woven", "ruled", "studio", 1, 2.0, 0),
     "sunlit wall": Look("plain", "bricks", "sun", 1, 3.0, 75),
     "park video": Look("stripes", "park", "studio", 3, 4.0, 60),
+    "close lens": Look("woven", "ruled", "studio", 1, 2.0, 0, distance=3.5),
+    "panning": Look("woven", "ruled", "studio", 1, 2.0, 0, distance=3.5, pan=True),
 }
 
 
@@ -135,18 +142,51 @@ def view_rotations(lateral: np.ndarray) -> dict[str, np.ndarray]:
     side = lateral / np.linalg.norm(lateral)
     forward = np.cross(side, up)
 
-    def look(d):
-        z = d / np.linalg.norm(d)
-        return np.stack([np.cross(-up, z), -up, z])
-
     a = np.radians(60)
-    return {"lateral": look(side), "endon": look(-forward),
-            "oblique60": look(np.cos(a) * side - np.sin(a) * forward)}
+    return {"lateral": _looking(side), "endon": _looking(-forward),
+            "oblique60": _looking(np.cos(a) * side - np.sin(a) * forward)}
 
 
 def job_camera(R: np.ndarray, centre: np.ndarray) -> dict:
     return {"model": "scaled_orthographic", "R": R.tolist(), "t": (-R @ centre).tolist(),
             "scale": PIXELS_PER_METRE, "center": [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5]}
+
+
+def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
+    """Each view's job camera in ``look``: the clip's orthographic one, or a pinhole
+    ``look.distance`` metres back along its line of sight showing the stage's centre as
+    large; a panning camera's R and t given per frame (the capture's 30 fps), turned about
+    the vertical to look at the root's horizontal position."""
+    cams = json.loads((clip_dir / "cameras.json").read_text())
+    if look.distance is None:
+        return cams
+    from core.bvh import read_bvh
+
+    root = read_bvh(clip_dir / "truth.bvh").poses()[1]
+    out = {}
+    for v, cam in cams.items():
+        R = np.array(cam["R"])
+        centre = -R.T @ np.array(cam["t"])
+        position = centre - look.distance * R[2]
+        f = PIXELS_PER_METRE * look.distance
+        K = [[f, 0.0, WIDTH / 2 - 0.5], [0.0, f, HEIGHT / 2 - 0.5], [0.0, 0.0, 1.0]]
+        if look.pan and v == "lateral":
+            sight = root - position
+            sight[:, 1] = 0.0  # turned about the vertical only
+            Rs = [_looking(d) for d in sight]
+            out[v] = {"model": "pinhole", "K": K, "R": [r.tolist() for r in Rs],
+                      "t": [(-r @ position).tolist() for r in Rs]}
+        else:
+            out[v] = {"model": "pinhole", "K": K, "R": R.tolist(),
+                      "t": (-R @ position).tolist()}
+    return out
+
+
+def _looking(direction: np.ndarray) -> np.ndarray:
+    """World-to-camera rotation of a level camera looking along ``direction``."""
+    up = np.array([0.0, 1.0, 0.0])
+    z = direction / np.linalg.norm(direction)
+    return np.stack([np.cross(-up, z), -up, z])
 
 
 def stage(clip: Clip, out: Path) -> dict:
@@ -182,11 +222,13 @@ def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
 
     n = len(read_bvh(truth).motion)
     meta = {"look": asdict(look), "frames": n, "version": 1}
+    if look.distance is None:  # as the looks' stamps were before lenses were looks
+        del meta["look"]["distance"], meta["look"]["pan"]
     ext = "jpg" if look.jpeg else "png"
     done = stamp.is_file() and json.loads(stamp.read_text()) == meta
     if done and all((out / v / f"{n - 1:04d}.{ext}").is_file() for v in VIEWS):
         return 0
-    cams = json.loads((clip_dir / "cameras.json").read_text())
+    cams = look_cameras(clip_dir, look)
     sk = skeleton_from_bvh(read_bvh(truth))
     parts = Parts.of(sk.names)
     _, body = build_scene(bpy, truth, radii=parts.radii(RADII), width=WIDTH, height=HEIGHT)
@@ -198,12 +240,18 @@ def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
     rng = np.random.default_rng(n * 7919 + len(look_name))
     tmp = out / "_subframe.png"
     for k, v in enumerate(VIEWS):
-        R = np.array(cams[v]["R"])
-        centre = -R.T @ np.array(cams[v]["t"])
-        scene.camera = add_camera(bpy, v, R, centre, WIDTH / PIXELS_PER_METRE)
+        Rs, ts = np.array(cams[v]["R"]).reshape(-1, 3, 3), np.array(cams[v]["t"]).reshape(-1, 3)
+        look_at = -Rs[0].T @ ts[0] + (look.distance or 0.0) * Rs[0][2]
+        scene.camera = add_camera(bpy, v, Rs[0], look_at, WIDTH / PIXELS_PER_METRE,
+                                  look.distance)
         back = backdrop_image(look.backdrop, seed=17 + k)
         (out / v).mkdir(parents=True, exist_ok=True)
         for f in range(n):
+            if len(Rs) > 1:  # a pan: the camera turns, the (periodic) backdrop slides past
+                place_camera(scene.camera, Rs[f], -Rs[f].T @ ts[f])
+                turn = np.arctan2(Rs[f][2] @ Rs[0][0], Rs[f][2] @ Rs[0][2])
+                back = np.roll(backdrop_image(look.backdrop, seed=17 + k),
+                               -int(round(PIXELS_PER_METRE * look.distance * np.tan(turn))), 1)
             acc = np.zeros((HEIGHT, WIDTH, 3))
             for s in range(look.blur):
                 sub = (s / look.blur - 0.5) * 0.5 if look.blur > 1 else 0.0  # half a frame

@@ -107,3 +107,36 @@ def test_views_look_across_the_body_at_its_front_and_between(yaw):
     assert rots["lateral"][2] @ lateral == pytest.approx(1.0)
     assert rots["endon"][2] @ forward == pytest.approx(-1.0)  # it walks toward the camera
     assert rots["oblique60"][2] @ lateral == pytest.approx(0.5)
+
+
+def test_a_close_lens_shows_the_stage_centre_as_large_and_a_pan_keeps_the_root_centred(
+        tmp_path):
+    """The perspective looks' cameras: each pinhole shows the stage's centre where and as
+    large as its orthographic twin does; the panning lateral camera turns with the root,
+    keeping it on the image's middle column while its centre stays put."""
+    from suite import CLIPS
+    from suite_footage import HEIGHT, LOOKS, PIXELS_PER_METRE, WIDTH, look_cameras, stage
+
+    from core.job import parse_camera
+
+    clip_dir = tmp_path / "clip"
+    stage(CLIPS[0], clip_dir)
+    ortho = look_cameras(clip_dir, LOOKS["muybridge"])
+    close = look_cameras(clip_dir, LOOKS["close lens"])
+    pan = look_cameras(clip_dir, LOOKS["panning"])
+    root = read_bvh(clip_dir / "truth.bvh").poses()[1]
+    for v in ortho:
+        (o,), _ = parse_camera(ortho[v], v)
+        (p,), _ = parse_camera(close[v], v)
+        centre = -o.pose.R.T @ o.pose.t
+        np.testing.assert_allclose(p.project(centre), [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5])
+        assert p.scale_at(centre) == pytest.approx(PIXELS_PER_METRE)
+        np.testing.assert_allclose(p.orientation, o.orientation)
+    path, _ = parse_camera(pan["lateral"], "lateral")
+    assert len(path) == len(root)
+    x = [cam.project(r)[0] for cam, r in zip(path, root)]
+    np.testing.assert_allclose(x, WIDTH / 2 - 0.5, atol=1e-6)
+    np.testing.assert_allclose([c.centre for c in path], np.repeat(path[:1][0].centre[None],
+                                                                    len(path), 0), atol=1e-9)
+    turned = np.degrees(se3.angle_between_vectors(path[0].R[2], path[-1].R[2]))
+    assert turned > 5  # the walker crosses the view: the camera follows
