@@ -48,17 +48,21 @@ def _writable(path: str, what: str) -> str:
     return ""
 
 
+def _refused(why: str) -> int:
+    """Say why nothing was done; the exit status of unusable input (2)."""
+    print(f"error: {why}", file=sys.stderr)
+    return 2
+
+
 def _track(args) -> int:
     problems = [p for p in (_writable(args.out, "output BVH"),
                             args.report and _writable(args.report, "report")) if p]
     if problems:
-        print(f"error: {problems[0]}", file=sys.stderr)
-        return 2
+        return _refused(problems[0])
     try:
         job = load_job(args.job)
     except JobError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+        return _refused(str(e))
 
     done_so_far = TrackResult()
 
@@ -106,14 +110,12 @@ def _track(args) -> int:
 def _fit(args) -> int:
     problem = _writable(args.out, "fitted BVH")
     if problem:
-        print(f"error: {problem}", file=sys.stderr)
-        return 2
+        return _refused(problem)
     try:
         job = load_fit(args.job)
         res = fit_pose(job.skeleton, job.guess, job.clicks, job.mode, job.fit_lengths)
     except (JobError, FitError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+        return _refused(str(e))
     R, root = world_pose(job.mode, job.cameras[0], res.pose)
     out = job.bvh.with_motion(R[None], root[None])
     out.joints = [dataclasses.replace(j, offset=o) for j, o in zip(out.joints,
@@ -128,17 +130,14 @@ def _fit(args) -> int:
 
 def _plate(args) -> int:
     if not Path(args.plate).is_file():
-        print(f"error: {args.plate}: no such image", file=sys.stderr)
-        return 2
+        return _refused(f"{args.plate}: no such image")
     problem = _writable(args.out, "frames' folder")  # the folder itself is made
     if problem:
-        print(f"error: {problem}", file=sys.stderr)
-        return 2
+        return _refused(problem)
     try:
         cells, paths = write_frames(args.plate, args.out, args.per_row)
     except InputError as e:
-        print(f"error: {args.plate}: {e}", file=sys.stderr)
-        return 2
+        return _refused(f"{args.plate}: {e}")
     rows = len({c.box[1] for c in cells})
     print(f"{len(cells)} cells in {rows} rows -> {paths[0].name} ... {paths[-1].name} in "
           f"{args.out}; each cell's offset down from the first's: "
@@ -150,13 +149,11 @@ def _plate(args) -> int:
 def _cameras(args) -> int:
     problem = _writable(args.out, "cameras file")
     if problem:
-        print(f"error: {problem}", file=sys.stderr)
-        return 2
+        return _refused(problem)
     try:
         cams = read_calibration(args.calibration, args.scale)
     except CalibrationError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+        return _refused(str(e))
     write_cameras(cams, args.out)
     for c in cams:
         size = f"{c.size[0]}x{c.size[1]}" if c.size else "size not given"

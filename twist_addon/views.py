@@ -105,18 +105,12 @@ def add_footage_view(context, path: Path, first_frame: int) -> str:
     return message
 
 
-class TWIST_OT_add_view(bpy.types.Operator):
-    """Add a view: an orthographic camera with the footage behind it, one image per frame"""
+class _FromFile:
+    """An operator on one file the user picks (``filepath``), beside which it may write:
+    ``run(context, path)`` does the work and returns what was done; an error it raises, a
+    missing file or a folder that cannot be written is reported instead, nothing done."""
 
-    bl_idname = "twist.add_view"
-    bl_label = "Add View"
-    bl_options = {"REGISTER", "UNDO"}
-
-    filepath: bpy.props.StringProperty(
-        name="Footage", subtype="FILE_PATH",
-        description="A movie, or any image of the footage: its folder's images of the same "
-                    "kind are read in name order")
-    first_frame: first_frame_property()
+    kind = "file"  # what the file is, for the message when it is missing
 
     def invoke(self, context, event):
         context.window_manager.fileselect_add(self)
@@ -125,24 +119,47 @@ class TWIST_OT_add_view(bpy.types.Operator):
     def execute(self, context):
         path = Path(bpy.path.abspath(self.filepath))
         if not path.is_file():
-            self.report({"ERROR"}, f"{self.filepath}: no such image or movie file")
+            self.report({"ERROR"}, f"{self.filepath}: no such {self.kind}")
             return {"CANCELLED"}
         try:
-            message = add_footage_view(context, path, self.first_frame)
-        except BridgeError as e:
+            message = self.run(context, path)
+        except InputError as e:
             self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except OSError as e:
+            self.report({"ERROR"}, f"cannot write beside {path.name} into {path.parent} "
+                        f"({e.strerror}): copy it into a folder you can write to")
             return {"CANCELLED"}
         self.report({"INFO"}, message)
         return {"FINISHED"}
 
 
-class TWIST_OT_add_plate_view(bpy.types.Operator):
+class TWIST_OT_add_view(_FromFile, bpy.types.Operator):
+    """Add a view: an orthographic camera with the footage behind it, one image per frame"""
+
+    bl_idname = "twist.add_view"
+    bl_label = "Add View"
+    bl_options = {"REGISTER", "UNDO"}
+    kind = "image or movie file"
+
+    filepath: bpy.props.StringProperty(
+        name="Footage", subtype="FILE_PATH",
+        description="A movie, or any image of the footage: its folder's images of the same "
+                    "kind are read in name order")
+    first_frame: first_frame_property()
+
+    def run(self, context, path: Path) -> str:
+        return add_footage_view(context, path, self.first_frame)
+
+
+class TWIST_OT_add_plate_view(_FromFile, bpy.types.Operator):
     """Add a view from a printed plate: its cells cut out, lined up on the ground line and
     written as an image sequence beside the plate, then added as the view's footage"""
 
     bl_idname = "twist.add_plate_view"
     bl_label = "Add View from Plate"
     bl_options = {"REGISTER", "UNDO"}
+    kind = "image file"
 
     filepath: bpy.props.StringProperty(
         name="Plate", subtype="FILE_PATH",
@@ -153,29 +170,14 @@ class TWIST_OT_add_plate_view(bpy.types.Operator):
                     "the cells touch with no gutter between them)")
     first_frame: first_frame_property()
 
-    def invoke(self, context, event):
-        context.window_manager.fileselect_add(self)
-        return {"RUNNING_MODAL"}
-
-    def execute(self, context):
-        plate = Path(bpy.path.abspath(self.filepath))
-        if not plate.is_file():
-            self.report({"ERROR"}, f"{self.filepath}: no such image file")
-            return {"CANCELLED"}
+    def run(self, context, plate: Path) -> str:
         out = plate.parent / f"{plate.stem}_frames"
         try:
             cells, paths = write_frames(plate, out, self.per_row or None)
-            message = add_footage_view(context, paths[0], self.first_frame)
-        except (InputError, BridgeError) as e:
-            self.report({"ERROR"}, f"{plate.name}: {e}")
-            return {"CANCELLED"}
-        except OSError as e:
-            self.report({"ERROR"}, f"cannot write the plate's frames into {out} ({e.strerror})"
-                        ": copy the plate into a folder you can write to")
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"{plate.name}: {len(cells)} cells cut into {out.name}/; "
-                    + message)
-        return {"FINISHED"}
+        except InputError as e:
+            raise BridgeError(f"{plate.name}: {e}") from None
+        message = add_footage_view(context, paths[0], self.first_frame)
+        return f"{plate.name}: {len(cells)} cells cut into {out.name}/; " + message
 
 
 def _camera_footage(folder: Path, name: str) -> Path:
@@ -243,7 +245,7 @@ def add_calibrated_views(context, calibration: Path, first_frame: int) -> str:
             + f"; the scene is {cams[0].size[0]}x{cams[0].size[1]}, Calibrated")
 
 
-class TWIST_OT_add_calibrated_views(bpy.types.Operator):
+class TWIST_OT_add_calibrated_views(_FromFile, bpy.types.Operator):
     """Add one view per camera of a calibration file (OpenCV, Pose2Sim, Qualisys): perspective
     cameras placed as calibrated, each with its movie or frames folder named after it beside
     the file (undistorted first where the lens distorts)"""
@@ -251,6 +253,7 @@ class TWIST_OT_add_calibrated_views(bpy.types.Operator):
     bl_idname = "twist.add_calibrated_views"
     bl_label = "Add Views from Calibration"
     bl_options = {"REGISTER", "UNDO"}
+    kind = "calibration file"
 
     filepath: bpy.props.StringProperty(
         name="Calibration", subtype="FILE_PATH",
@@ -258,24 +261,8 @@ class TWIST_OT_add_calibrated_views(bpy.types.Operator):
                     "each camera's footage beside it, named after the camera")
     first_frame: first_frame_property()
 
-    def invoke(self, context, event):
-        context.window_manager.fileselect_add(self)
-        return {"RUNNING_MODAL"}
-
-    def execute(self, context):
-        path = Path(bpy.path.abspath(self.filepath))
-        try:
-            message = add_calibrated_views(context, path, self.first_frame)
-        except BridgeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        except OSError as e:
-            self.report({"ERROR"}, f"cannot write the undistorted footage beside {path.name} "
-                        f"({e.strerror}): copy the calibration and footage into a folder you "
-                        "can write to")
-            return {"CANCELLED"}
-        self.report({"INFO"}, message)
-        return {"FINISHED"}
+    def run(self, context, path: Path) -> str:
+        return add_calibrated_views(context, path, self.first_frame)
 
 
 class TWIST_OT_remove_view(bpy.types.Operator):
