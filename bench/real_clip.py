@@ -272,8 +272,9 @@ def _table(e_track, e_still, rep, fit_log, seconds, lower_back) -> list[str]:
         "| run | all frames | first 5 | last 5 | cam01 | cam02 | cam03 | cam04 |",
         "|---|---|---|---|---|---|---|---|",
         row("tracked", e_track), row("first pose held still", e_still), "",
-        f"first frame's fit: {fit_log.splitlines()[0]}; tracked {rep['frames_tracked']} of "
-        f"{rep['frames_total']} frames in {seconds:.0f} s; frames to check: "
+        f"first frame's fit: {fit_log.splitlines()[0].split(' -> ')[0]}; tracked "
+        f"{rep['frames_tracked']} of {rep['frames_total']} frames in {seconds:.0f} s; frames "
+        "to check: "
         f"{len(rep['frames_to_check'])}"]
 
 
