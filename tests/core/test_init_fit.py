@@ -7,7 +7,7 @@ import pytest
 
 from core import se3
 from core.bvh import read_bvh
-from core.camera import View
+from core.camera import Pinhole, View
 from core.init_fit import FitError, fit_pose, least_certain, symmetry_key
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose
 from core.skeleton import BALL, HINGE, Skeleton, skeleton_from_bvh
@@ -25,12 +25,17 @@ LIMBS = [("LeftHip", "LeftKnee"), ("RightHip", "RightKnee"), ("LeftKnee", "LeftA
          ("RightElbow", "RightWrist")]
 
 
-def _views(n):
+def _views(n, pinhole=False):
+    """Views of a body 700 px tall: scaled orthographic, or pinholes 2.5 m away."""
     out = []
     for yaw in [90, 0, 60][:n]:
         R = np.diag([1.0, -1, -1]) @ se3.exp_so3(np.radians([0, yaw, 0]))
-        out.append(View(se3.Similarity(400.0, R, -R @ [0.3, 0.9, -1.5] + [0, 0, 5]),
-                        np.array([540.0, 540.0])))  # a body 700 px tall
+        if pinhole:
+            K = np.array([[1000.0, 0, 540], [0, 1000.0, 540], [0, 0, 1]])
+            out.append(Pinhole(K, R, -R @ [0.3, 0.9, -1.5] + [0, 0, 2.5]))
+        else:
+            out.append(View(se3.Similarity(400.0, R, -R @ [0.3, 0.9, -1.5] + [0, 0, 5]),
+                            np.array([540.0, 540.0])))
     return out
 
 
@@ -78,15 +83,17 @@ def _clicks(true_sk, R, p, views, rng, noise=1.0):
     return out
 
 
-@pytest.mark.parametrize("mode", [CALIBRATED, INDEPENDENT])
+@pytest.mark.parametrize("mode, pinhole", [(CALIBRATED, False), (INDEPENDENT, False),
+                                           (CALIBRATED, True)])
 @pytest.mark.parametrize("noise, seed", [(0.0, 0), (1.0, 0), (1.0, 5), (2.0, 0)])
-def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, noise, seed):
+def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, pinhole, noise,
+                                                               seed):
     b, guess_sk = _body(cmu_walk)
     rng = np.random.default_rng(seed)
     true_sk = _scaled(guess_sk, rng)
     R_guess, p_guess = b.frame_pose(590)  # a nearby frame of the walk: the starting guess
     R_true, p_true = _representable(guess_sk, R_guess, *b.frame_pose(600))
-    views = _views(3)
+    views = _views(3, pinhole)
     clicks = _clicks(true_sk, R_true, p_true, views, rng, noise)
     res = fit_pose(guess_sk, BodyPose(R_guess, p_guess, views), clicks, mode)
     X = true_sk.world_positions(R_true, p_true)
@@ -129,7 +136,10 @@ def test_recovers_limb_directions_and_lengths_from_three_views(cmu_walk, mode, n
     # proportions within 1 %. The errors grow with the noise: at 2 px over the same seeds,
     # mean 1.4 (calibrated) and 1.8 (independent) degrees, worst limb 1.9-5.5, lengths and
     # proportions within 2.6 %
-    assert np.mean(errs) < 1.5 * noise and np.max(errs) < 3.0 * noise, errs
+    # pinholes 2.5 m away, calibrated, 1 px over seeds 0-9: mean 0.6 degrees, worst limb
+    # 0.8-3.8 (the far side of the body is smaller in the image than the near side)
+    worst = 4.0 if pinhole else 3.0
+    assert np.mean(errs) < 1.5 * noise and np.max(errs) < worst * noise, errs
     assert np.max(np.abs(ratio - 1)) < 0.02 * noise, lens
     assert res.residual_px < 2 * noise
 
