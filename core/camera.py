@@ -14,9 +14,8 @@ right, y down, z away from the camera (OpenCV's convention).
 
 What the tracker asks of a camera: ``project``, ``pullback`` (image gradients carried to the
 world through the projection's Jacobian), ``scale_at`` (pixels per world unit at a point),
-``orientation`` (the camera's axes in the world), ``sight`` (the line of sight through a
-point), ``ray`` and ``ray_lines`` (the world ray of a pixel, affine in the pixel),
-``ellipses`` (an ellipsoid's outline), ``at_level`` and ``copy``.
+``orientation`` (the camera's axes in the world), ``ray`` and ``ray_lines`` (the world ray of a
+pixel, affine in the pixel), ``ellipses`` (an ellipsoid's outline), ``at_level`` and ``copy``.
 """
 
 from __future__ import annotations
@@ -60,11 +59,6 @@ class View:
     def orientation(self) -> np.ndarray:
         """(3, 3): the camera's x, y and z (line of sight) axes in the world, as rows."""
         return self.pose.R
-
-    def sight(self, X: np.ndarray) -> np.ndarray:
-        """The unit line of sight (3,) through the point X (3,), away from the camera: the
-        same everywhere."""
-        return self.pose.R[2].copy()
 
     def ray_lines(self) -> tuple[np.ndarray, ...]:
         """Pixel (u, v)'s world ray X(l) = o + l d with o = o0 + u ox + v oy and
@@ -159,12 +153,6 @@ class Pinhole:
     def orientation(self) -> np.ndarray:
         """(3, 3): the camera's x, y and z (optical axis) axes in the world, as rows."""
         return self.R
-
-    def sight(self, X: np.ndarray) -> np.ndarray:
-        """The unit line of sight (3,) through the point X (3,), away from the camera: off
-        the optical axis wherever X is off the image's centre."""
-        d = np.asarray(X, dtype=float) - self.centre
-        return d / np.linalg.norm(d)
 
     def ray_lines(self) -> tuple[np.ndarray, ...]:
         """Pixel (u, v)'s world ray X(l) = o + l d (see ``View.ray_lines``): o is the camera's

@@ -165,9 +165,8 @@ class LimbSearch:
             if n_views == 1:
                 view = next(v for v, fg in zip(views, fgs) if fg is not None)
                 j, axis, _ = limb.dofs[-1]
-                sight = view.sight(kin.frames[j, :3, 3])
-                if (self.sk.kinds[j] != HINGE
-                        or abs(sight @ kin.frames[j, :3, :3] @ axis) < SIDE_ON):
+                if (self.sk.kinds[j] != HINGE or abs(view.orientation[2] @ kin.frames[j, :3, :3]
+                                                      @ axis) < SIDE_ON):
                     continue
                 limb = _Limb(limb.joint, limb.own, limb.below, limb.dofs[-1:])
             rest = np.setdiff1d(np.arange(len(self.blobs)), limb.below)

@@ -22,7 +22,7 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
     footage shows such a turn only as foreshortening, the same for either sign. A ball joint
     is always one; a hinge is not when its axis at ``pose`` lies within 25 degrees of the
     line of sight (it turns in the image plane). Empty when the views look different ways."""
-    sight = [v.sight(pose.root_position) for v in pose.views]
+    sight = [v.orientation[2] for v in pose.views]
     if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
         return []
     frames = Kinematics(skeleton, pose).frames
@@ -37,9 +37,8 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
 
 def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     """``skeleton`` with every joint ``depth_blind_joints`` names at ``pose`` a hinge about
-    the line of sight through the root there (its axis in the joint's frame, its angle
-    free): the paper's body for one camera. ``skeleton`` itself when the views look
-    different ways."""
+    the line of sight there (its axis in the joint's frame, its angle free): the paper's body
+    for one camera. ``skeleton`` itself when the views look different ways."""
     blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose)]
     if not blind:
         return skeleton
@@ -47,7 +46,7 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
     for j in blind:
         kinds[j] = HINGE
-        axes[j] = frames[j, :3, :3].T @ pose.views[0].sight(pose.root_position)
+        axes[j] = frames[j, :3, :3].T @ pose.views[0].orientation[2]
         limits[j] = (-np.inf, np.inf)
     out = Skeleton(skeleton.names, skeleton.parents, skeleton.offsets, kinds, axes,
                    skeleton.end_sites, limits=limits)

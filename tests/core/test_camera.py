@@ -45,10 +45,3 @@ def test_rays_start_at_the_centre_and_pass_through_their_pixels_on_every_level()
         assert np.all(cam.camera_points(origin + 2.5 * d)[:, 2] > 0)  # away from the camera
     X = _points(seed=3)
     np.testing.assert_allclose(CAM.at_level(2).project(X) * 4, CAM.project(X), atol=1e-9)
-
-
-def test_the_line_of_sight_through_a_point_is_its_pixels_ray():
-    X = _points(seed=4)
-    _, d = CAM.ray(CAM.project(X))
-    np.testing.assert_allclose([CAM.sight(x) for x in X], d, atol=1e-9)
-    assert abs(CAM.sight(CAM.centre + 3 * CAM.R[2]) @ CAM.R[2] - 1) < 1e-12  # on the axis
