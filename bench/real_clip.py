@@ -36,6 +36,7 @@ sys.path.insert(0, str(ROOT))
 from core import raycast  # noqa: E402
 from core.bvh import BvhFile, BvhJoint, read_bvh, write_bvh  # noqa: E402
 from core.calibration import read_calibration  # noqa: E402
+from core.job import load_job  # noqa: E402
 from core.lens import Undistorted, distort_points, undistort_points  # noqa: E402
 from core.skeleton import BALL, HINGE, Skeleton, human_template  # noqa: E402
 from core.video import VideoFrames  # noqa: E402
@@ -178,7 +179,7 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None) -
     _run("track", WORK / "job.json", "--out", WORK / "tracked.bvh", "--report",
          WORK / "report.json", "--quiet")
     seconds = time.perf_counter() - t0
-    fsk = _skeleton_of(read_bvh(WORK / "fitted.bvh"), sk)
+    fsk = load_job(WORK / "job.json").skeleton  # the fitted body, with the blobs it tracked
     R, p = read_bvh(WORK / "tracked.bvh").poses()
     tracked = list(zip(R, p))
     e_track = errors_pct(fsk, tracked, cams, landmarks, visibility)
@@ -248,13 +249,6 @@ def _trim_movies(cams, n: int, job: dict) -> None:
         for f, img in zip(range(n), VideoFrames(DATA / f"{c.name}.mp4")):
             cv2.imwrite(str(folder / f"{f:04d}.png"), img)
         v["images"] = f"{c.name}/*.png"
-
-
-def _skeleton_of(fitted: BvhFile, template: Skeleton) -> Skeleton:
-    """The template with the fitted BVH's bone offsets."""
-    offsets = np.array([j.offset for j in fitted.joints], float)
-    return Skeleton(template.names, template.parents, offsets, template.kinds, template.axes,
-                    template.end_sites, limits=template.limits)
 
 
 def _table(e_track, e_still, rep, fit_log, seconds, lower_back) -> list[str]:
