@@ -28,7 +28,7 @@ from .bridge import (
 )
 from .errors import INPUT_ERRORS
 from .properties import settings_from_properties
-from .views import footage_frames
+from .views import footage_frames, unread_distortion
 
 
 @dataclass
@@ -45,6 +45,13 @@ class TrackSession:
     user_keys: dict[int, frozenset[str]] = field(default_factory=dict)  # frame -> bones
     corrections: dict[int, BodyPose] = field(default_factory=dict)  # by index in ``frames``
     tracked: list[FrameResult] = field(default_factory=list)
+    scene_notes: list[str] = field(default_factory=list)  # what the scene holds that the
+    # tracker cannot use (``views.unread_distortion``)
+
+    @property
+    def notes(self) -> list[str]:
+        """What the user should know about the run: the scene's notes, then the tracker's."""
+        return self.scene_notes + self.tracker.notes
 
     @classmethod
     def from_scene(cls, scene) -> TrackSession:
@@ -84,7 +91,9 @@ class TrackSession:
                 corrections[i] = BodyPose(*pose_from_armature(arm, sk), views)
         scene.frame_set(cur)
         R, root = pose_from_armature(arm, sk)
-        return cls(arm, frames, tracker, BodyPose(R, root, views), user_keys, corrections)
+        notes = [n for n in (unread_distortion(v) for v in tw.views) if n]
+        return cls(arm, frames, tracker, BodyPose(R, root, views), user_keys, corrections,
+                   scene_notes=notes)
 
     def keep_start_pose(self, scene) -> None:
         """Key the first frame's pose (the user's) there, on the bones with no key there yet,
@@ -133,7 +142,7 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
             f"{', '.join(map(str, kept[:3]))} ... {kept[-1]}"
         msg += f"; {len(kept)} frame{'s' * (len(kept) > 1)} ({listed}) held at the pose you " \
                "keyed"
-    notes = session.tracker.notes
+    notes = session.notes
     if notes:
         msg += "; " + "; ".join(notes)
     check = session.frames_to_check()
@@ -182,7 +191,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
         result.last_residual = tracked[-1].residual if len(tracked) > 1 else 0.0
         result.diverged_frames = ", ".join(
             f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
-        result.notes = "\n".join(self._session.tracker.notes)
+        result.notes = "\n".join(self._session.notes)
         result.frames_to_check = frame_list(self._session.frames_to_check())
         context.scene.frame_set(context.scene.frame_current)
         if not (cancelled or error):

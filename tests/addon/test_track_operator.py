@@ -427,3 +427,21 @@ def test_a_refine_round_that_fails_keeps_the_rounds_before_it(bpy_module, regist
                                atol=1e-6)
     keyed = _channel_frames(arm)
     assert all(set(range(2, 22)) <= {f for f, _ in keyed[b]} for b in TRACKED)
+
+
+def test_a_movie_clips_lens_distortion_is_named_as_not_undone(bpy_module, registered, footage):
+    """Footage shown through a movie clip whose lens distortion is set (Blender's camera
+    solver writes it there): the tracker reads frames as filmed, and Track says so."""
+    bpy = bpy_module
+    scene, _ = _scene(bpy, registered, footage, 3)
+    cam = scene.twist.views[0].camera
+    clip = bpy.data.movieclips.load(str(sorted((footage / VIEWS[0]).glob("*.png"))[0]))
+    bg = cam.data.background_images.new()
+    bg.source, bg.clip = "MOVIE_CLIP", clip
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    assert "has lens distortion" not in scene.twist.result.notes
+    bpy.ops.twist.clear_track()
+    clip.tracking.camera.k1 = -0.08
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    assert (f"the clip '{clip.name}' behind '{cam.name}' has lens distortion, which the "
+            "tracker does not undo") in scene.twist.result.notes
