@@ -18,7 +18,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .camera import Pinhole
+from . import se3
+from .camera import Pinhole, intrinsics_problem
 from .errors import InputError
 
 
@@ -55,10 +56,9 @@ def read_calibration(path: str | Path, scale: float = 1.0) -> list[CalibratedCam
         cams = _qualisys(path)
     elif name.endswith(".toml"):
         cams = _pose2sim(path)
-    elif name.endswith(".json") and _is_ours(path):
-        cams = _ours(path)
     elif name.endswith((".yml", ".yaml", ".json", ".xml")):
-        cams = _opencv(path)
+        ours = _ours(path) if name.endswith(".json") else None
+        cams = _opencv(path) if ours is None else ours
     else:
         raise CalibrationError(f"{path}: not a calibration format read here (OpenCV's .yml, "
                                ".yaml, .xml or .json; Pose2Sim's .toml; Qualisys' .qca.txt)")
@@ -72,12 +72,13 @@ def read_calibration(path: str | Path, scale: float = 1.0) -> list[CalibratedCam
 def _checked(path: Path, name: str, K, R, t, dist=None, size=None) -> CalibratedCamera:
     where = f"{path.name}: camera '{name}'"
     K, R, t = (np.asarray(x, dtype=float) for x in (K, R, t))
-    if K.shape != (3, 3) or R.shape != (3, 3) or t.size != 3:
-        raise CalibrationError(f"{where}: expected a 3x3 K, a 3x3 rotation and 3 translations")
-    if not (K[0, 0] > 0 and K[1, 1] > 0):
-        raise CalibrationError(f"{where}: focal lengths must be > 0, got {K[0, 0]}, {K[1, 1]}")
-    if not np.allclose(R @ R.T, np.eye(3), atol=1e-4) or np.linalg.det(R) < 0:
-        raise CalibrationError(f"{where}: its rotation is not a rotation matrix")
+    problem = intrinsics_problem(K)
+    if problem:
+        raise CalibrationError(f"{where}: K: {problem}")
+    if not se3.is_rotation(R):
+        raise CalibrationError(f"{where}: its rotation is not a 3x3 rotation matrix")
+    if t.size != 3:
+        raise CalibrationError(f"{where}: expected 3 translations, got {t.size}")
     d = None if dist is None else np.asarray(dist, dtype=float).ravel()
     if d is not None and not np.any(d):
         d = None
@@ -149,7 +150,8 @@ def _pose2sim(path: Path) -> list[CalibratedCamera]:
 _OPENCV_KEYS = {"K": ("camera_matrix", "cameraMatrix", "K", "intrinsic", "intrinsics"),
                 "dist": ("distortion_coefficients", "dist_coeffs", "distCoeffs", "D", "dist"),
                 "R": ("R", "rotation_matrix"), "rvec": ("rvec", "rotation", "r"),
-                "t": ("T", "t", "tvec", "translation")}
+                "t": ("T", "t", "tvec", "translation"),
+                "width": ("image_width", "width"), "height": ("image_height", "height")}
 
 
 def _opencv(path: Path) -> list[CalibratedCamera]:
@@ -173,7 +175,7 @@ def _opencv(path: Path) -> list[CalibratedCamera]:
             if R is None or t is None:
                 raise CalibrationError(f"{path.name}: camera '{name}' has no pose (R or rvec, "
                                        "and T): the tracker needs where each camera stands")
-            w, h = (_opencv_field(node, k, ("image_width", "width")) for k in ("w", "h"))
+            w, h = (_opencv_field(node, k) for k in ("width", "height"))
             size = None if w is None or h is None else (int(w.item()), int(h.item()))
             out.append(_checked(path, name, K, R, t, dist, size))
         return out
@@ -181,11 +183,10 @@ def _opencv(path: Path) -> list[CalibratedCamera]:
         fs.release()
 
 
-def _opencv_field(node, key: str, names=None) -> np.ndarray | None:
-    """A node's field by any of its usual names, as an array (None when absent)."""
-    if key in ("w", "h"):
-        names = ("image_width", "width") if key == "w" else ("image_height", "height")
-    for n in names or _OPENCV_KEYS[key]:
+def _opencv_field(node, key: str) -> np.ndarray | None:
+    """A node's field by any of its usual names (``_OPENCV_KEYS``), as an array (None when
+    absent)."""
+    for n in _OPENCV_KEYS[key]:
         sub = node.getNode(n)
         if sub.empty():
             continue
@@ -199,18 +200,17 @@ def _opencv_field(node, key: str, names=None) -> np.ndarray | None:
     return None
 
 
-def _is_ours(path: Path) -> bool:
+def _ours(path: Path) -> list[CalibratedCamera] | None:
+    """A ``cameras.json``'s cameras: ``{"cameras": [{"name", "K", "R", "t", "dist"?,
+    "size"?}]}``; None for a JSON file of another layout (OpenCV's)."""
     try:
         data = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError):
-        return False
-    return isinstance(data, dict) and isinstance(data.get("cameras"), list)
-
-
-def _ours(path: Path) -> list[CalibratedCamera]:
-    """A ``cameras.json``: ``{"cameras": [{"name", "K", "R", "t", "dist"?, "size"?}]}``."""
+        return None
+    if not isinstance(data, dict) or not isinstance(data.get("cameras"), list):
+        return None
     out = []
-    for i, cam in enumerate(json.loads(path.read_text())["cameras"]):
+    for i, cam in enumerate(data["cameras"]):
         name = str(cam.get("name", f"camera {i + 1}"))
         try:
             out.append(_checked(path, name, cam["K"], cam["R"], cam["t"], cam.get("dist"),

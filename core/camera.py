@@ -202,6 +202,18 @@ class Pinhole:
 Camera = View | Pinhole
 
 
+def intrinsics_problem(K: np.ndarray) -> str:
+    """'' for intrinsics K a ``Pinhole`` can take, else what is wrong with them."""
+    K = np.asarray(K, dtype=float)
+    if K.shape != (3, 3) or not np.all(np.isfinite(K)):
+        return "expected a 3x3 matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]"
+    if K[1, 0] != 0 or K[2, 0] != 0 or K[2, 1] != 0 or K[2, 2] != 1:
+        return f"expected an upper triangular matrix with last row [0, 0, 1], got {K.tolist()}"
+    if not (K[0, 0] > 0 and K[1, 1] > 0):
+        return f"the focal lengths fx = {K[0, 0]:g}, fy = {K[1, 1]:g} (pixels) must be > 0"
+    return ""
+
+
 def _rays(camera: Camera, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``ray`` of either camera, from its ``ray_lines``."""
     pixels = np.asarray(pixels, dtype=float)

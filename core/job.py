@@ -19,7 +19,7 @@ import numpy as np
 from . import se3
 from .bvh import BvhError, BvhFile, read_bvh
 from .calibration import CalibrationError, read_calibration
-from .camera import Camera, Pinhole, View
+from .camera import Camera, Pinhole, View, intrinsics_problem
 from .errors import InputError
 from .image import ImageError
 from .init_fit import FitError, clicked_point
@@ -69,10 +69,6 @@ def _vector(v, n: int, where: str) -> np.ndarray:
     return a
 
 
-def _is_rotation(R: np.ndarray) -> bool:
-    return bool(np.allclose(R @ R.T, np.eye(3), atol=1e-4) and np.linalg.det(R) > 0)
-
-
 def _poses(d: dict, where: str) -> tuple[np.ndarray, np.ndarray]:
     """A camera's ``R`` and ``t``: one of each for a camera that stands still, or one per
     frame for one that moves (F, 3, 3) and (F, 3); a still camera's F is 1."""
@@ -85,7 +81,7 @@ def _poses(d: dict, where: str) -> tuple[np.ndarray, np.ndarray]:
     if R.ndim != 3 or R.shape[1:] != (3, 3):
         raise JobError(f"{where}.R: expected a 3x3 rotation matrix (list of 3 rows), or one "
                        "per frame for a camera that moves")
-    bad = [i for i, r in enumerate(R) if not _is_rotation(r)]
+    bad = [i for i, r in enumerate(R) if not se3.is_rotation(r)]
     if bad:
         at = f" (frame {bad[0]})" if len(R) > 1 else ""
         raise JobError(f"{where}.R: expected a 3x3 rotation matrix (orthonormal, det +1){at}")
@@ -107,16 +103,10 @@ def _intrinsics(d: dict, where: str) -> np.ndarray:
     try:
         K = np.asarray(_field(d, "K", where), dtype=float)
     except (TypeError, ValueError):
-        raise JobError(f"{where}.K: expected a 3x3 matrix [[fx, 0, cx], [0, fy, cy], "
-                       "[0, 0, 1]]") from None
-    if K.shape != (3, 3) or not np.all(np.isfinite(K)):
-        raise JobError(f"{where}.K: expected a 3x3 matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]")
-    if K[1, 0] != 0 or K[2, 0] != 0 or K[2, 1] != 0 or K[2, 2] != 1:
-        raise JobError(f"{where}.K: expected an upper triangular matrix with last row "
-                       f"[0, 0, 1], got {K.tolist()}")
-    if not (K[0, 0] > 0 and K[1, 1] > 0):
-        raise JobError(f"{where}.K: the focal lengths fx = {K[0, 0]:g}, fy = {K[1, 1]:g} "
-                       "(pixels) must be > 0")
+        K = np.zeros(0)
+    problem = intrinsics_problem(K)
+    if problem:
+        raise JobError(f"{where}.K: {problem}")
     return K
 
 

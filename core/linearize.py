@@ -12,8 +12,7 @@ that a world displacement dX of the point changes the brightness by m . dX. Then
   [g.d, Ix, Iy, (d x g)] with g = (Ix, Iy, 0)  -- paper eq. 18 with the pivot moved to q_r.
 * One column per joint degree of freedom, a turn about the world axis a through the point o:
   m . (a x (X - o)) = a . ((X - c) x m) - m . (a x (o - c)) (paper eq. 26 carried to the
-  world), zero on
-  pixels whose segment that joint does not move (eq. 30).
+  world), zero on pixels whose segment that joint does not move (eq. 30).
 
 Everything is vectorised over pixels; the joint block is two (N, 3) x (3, D) products.
 """

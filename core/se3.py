@@ -192,6 +192,13 @@ def frame_along(u: np.ndarray) -> np.ndarray:
     return np.stack([u, v, np.cross(u, v)])
 
 
+def is_rotation(R: np.ndarray, tol: float = 1e-4) -> bool:
+    """Whether R is a 3x3 rotation matrix: orthonormal within ``tol``, determinant +1."""
+    R = np.asarray(R, dtype=float)
+    return bool(R.shape == (3, 3) and np.allclose(R @ R.T, np.eye(3), atol=tol)
+                and np.linalg.det(R) > 0)
+
+
 def rotation_angle_between(R1: np.ndarray, R2: np.ndarray) -> np.ndarray:
     """Angle (radians) of R1^T R2, robust in float32 via atan2; works on stacks (..., 3, 3)."""
     D = np.swapaxes(R1, -1, -2) @ R2
