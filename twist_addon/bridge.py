@@ -233,13 +233,17 @@ def camera_path(cam, scene, frames) -> list[Camera] | None:
     return path if any(not np.allclose(n, numbers[0]) for n in numbers) else None
 
 
-def tracking_mode(scene, views: list[Camera]) -> str:
-    """The core mode of the scene's *Views* setting; perspective cameras are calibrated only
-    (a BridgeError says so under *Independent*)."""
+def tracking_mode(scene, views: list[Camera], moving=()) -> str:
+    """The core mode of the scene's *Views* setting; perspective cameras and cameras that
+    move (``moving``: per view, its ``camera_path``) are calibrated only (a BridgeError says
+    so under *Independent*)."""
     mode = scene.twist.mode.lower()
     if mode != CALIBRATED and any(v.central for v in views):
         raise BridgeError("perspective cameras are placed where they filmed from: set Views "
                           "to Calibrated (or make the cameras orthographic)")
+    if mode != CALIBRATED and any(m is not None for m in moving):
+        raise BridgeError("a view's camera moves over the frames: set Views to Calibrated "
+                          "(the body's root is then tracked in the world)")
     return mode
 
 

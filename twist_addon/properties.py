@@ -72,7 +72,8 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
 
     camera: bpy.props.PointerProperty(
         type=bpy.types.Object, poll=_is_camera, name="Camera",
-        description="The orthographic camera the footage was seen through")
+        description="The camera the footage was seen through (orthographic, or "
+                    "perspective with Views set to Calibrated)")
     images: bpy.props.StringProperty(
         name="Footage", subtype="FILE_PATH", options={"PATH_SUPPORTS_BLEND_RELATIVE"},
         description="The footage's frames: a glob such as //walk/side_*.png (// is the .blend's "

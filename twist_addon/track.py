@@ -13,7 +13,7 @@ import bpy
 
 from ..core.confidence import frame_list
 from ..core.frame_fit import FrameResult
-from ..core.pose import CALIBRATED, BodyPose, world_pose
+from ..core.pose import BodyPose, world_pose
 from ..core.tracker import Tracker, frames_to_check, frames_tracked
 from . import checks, keyframes
 from .armature_action import ArmatureAction
@@ -75,10 +75,7 @@ class TrackSession:
             views.append(view_from_camera(v.camera, scene))
             images.append(footage_frames(v, frames))
             moving.append(camera_path(v.camera, scene, frames))
-        mode = tracking_mode(scene, views)
-        if mode != CALIBRATED and any(m is not None for m in moving):
-            raise BridgeError("a view's camera moves over the frames: set Views to Calibrated "
-                              "(the body's root is then tracked in the world)")
+        mode = tracking_mode(scene, views, moving)
         sk = tracked_skeleton(arm)
         settings = settings_from_properties(tw.tracker)
         # the tracker indexes frames 0..n-1 in tracking order, the cameras' paths too

@@ -134,6 +134,7 @@ class _FromFile:
     ``run(context, path)`` does the work and returns what was done; an error it raises, a
     missing file or a folder that cannot be written is reported instead, nothing done."""
 
+    bl_options = {"REGISTER", "UNDO"}
     kind = "file"  # what the file is, for the message when it is missing
 
     def invoke(self, context, event):
@@ -163,7 +164,6 @@ class TWIST_OT_add_view(_FromFile, bpy.types.Operator):
 
     bl_idname = "twist.add_view"
     bl_label = "Add View"
-    bl_options = {"REGISTER", "UNDO"}
     kind = "image or movie file"
 
     filepath: bpy.props.StringProperty(
@@ -182,7 +182,6 @@ class TWIST_OT_add_plate_view(_FromFile, bpy.types.Operator):
 
     bl_idname = "twist.add_plate_view"
     bl_label = "Add View from Plate"
-    bl_options = {"REGISTER", "UNDO"}
     kind = "image file"
 
     filepath: bpy.props.StringProperty(
@@ -276,7 +275,6 @@ class TWIST_OT_add_calibrated_views(_FromFile, bpy.types.Operator):
 
     bl_idname = "twist.add_calibrated_views"
     bl_label = "Add Views from Calibration"
-    bl_options = {"REGISTER", "UNDO"}
     kind = "calibration file"
 
     filepath: bpy.props.StringProperty(
