@@ -34,7 +34,7 @@ def world_points(sk: Skeleton, rotations: np.ndarray, roots: np.ndarray) -> np.n
     return np.array([sk.world_positions(R, p) for R, p in zip(rotations, roots)])
 
 
-def _point(sk: Skeleton, frames: np.ndarray, name: str) -> np.ndarray:
+def named_point(sk: Skeleton, frames: np.ndarray, name: str) -> np.ndarray:
     """World position of a joint, or of "<joint>/end", its first end site, given its frames."""
     joint, _, end = name.partition("/")
     M = frames[sk.index(joint)]
@@ -46,7 +46,7 @@ def limb_ends(sk: Skeleton, rotations, roots, limbs=LIMBS) -> dict[str, np.ndarr
     eight limb bones first; by default the CMU walk's ``LIMBS``)."""
     frames = [sk.joint_frames(R, p) for R, p in zip(rotations, roots)]
     names = {name for _, a, b in limbs for name in (a, b)}
-    return {name: np.array([_point(sk, M, name) for M in frames]) for name in sorted(names)}
+    return {name: np.array([named_point(sk, M, name) for M in frames]) for name in sorted(names)}
 
 
 def limb_vectors(sk: Skeleton, rotations, roots, limbs=LIMBS) -> dict[str, np.ndarray]:

@@ -32,6 +32,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import evaluate  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import BvhFile, BvhJoint, read_bvh, write_bvh  # noqa: E402
@@ -116,13 +119,7 @@ def _run(*args) -> subprocess.CompletedProcess:
 def point_positions(sk: Skeleton, R: np.ndarray, root: np.ndarray) -> dict[str, np.ndarray]:
     """World positions of the scored points of a pose."""
     M = sk.joint_frames(R, root)
-    out = {}
-    for name in POINTS:
-        joint, _, end = name.partition("/")
-        j = sk.index(joint)
-        tip = np.asarray(sk.end_sites[j][0], float) if end else np.zeros(3)
-        out[name] = M[j, :3, :3] @ tip + M[j, :3, 3]
-    return out
+    return {name: evaluate.named_point(sk, M, name) for name in POINTS}
 
 
 def errors_pct(sk: Skeleton, poses: list, cams, landmarks: np.ndarray, visibility: np.ndarray

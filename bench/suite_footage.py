@@ -25,7 +25,15 @@ from pathlib import Path
 
 import numpy as np
 from captures import Parts, normalized
-from walk_footage import RADII, add_camera, backdrop, build_scene, cloth_colour, place_camera
+from walk_footage import (
+    RADII,
+    add_camera,
+    backdrop,
+    build_scene,
+    cloth_colour,
+    pinhole_job_camera,
+    place_camera,
+)
 
 from core.bvh import write_bvh
 from core.skeleton import skeleton_from_bvh
@@ -168,17 +176,13 @@ def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
         R = np.array(cam["R"])
         centre = -R.T @ np.array(cam["t"])
         position = centre - look.distance * R[2]
-        f = PIXELS_PER_METRE * look.distance
-        K = [[f, 0.0, WIDTH / 2 - 0.5], [0.0, f, HEIGHT / 2 - 0.5], [0.0, 0.0, 1.0]]
+        Rs = [R]
         if look.pan and v == "lateral":
             sight = root - position
             sight[:, 1] = 0.0  # turned about the vertical only
             Rs = [_looking(d) for d in sight]
-            out[v] = {"model": "pinhole", "K": K, "R": [r.tolist() for r in Rs],
-                      "t": [(-r @ position).tolist() for r in Rs]}
-        else:
-            out[v] = {"model": "pinhole", "K": K, "R": R.tolist(),
-                      "t": (-R @ position).tolist()}
+        out[v] = pinhole_job_camera(Rs, position, PIXELS_PER_METRE * look.distance,
+                                    [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5])
     return out
 
 

@@ -132,14 +132,19 @@ def job_camera(R: np.ndarray, zoom: int = 1, distance: float | None = None,
         return {"model": "scaled_orthographic", "R": R.tolist(),
                 "t": (-R @ STAGE_CENTRE).tolist(), "scale": PIXELS_PER_METRE * zoom,
                 "center": center}
-    f = PIXELS_PER_METRE * zoom * distance
-    position = STAGE_CENTRE - distance * R[2]
+    Rs = [R] if pans is None else [panned(R, a) for a in pans]
+    return pinhole_job_camera(Rs, STAGE_CENTRE - distance * R[2],
+                              PIXELS_PER_METRE * zoom * distance, center)
+
+
+def pinhole_job_camera(Rs: list[np.ndarray], position: np.ndarray, f: float, center) -> dict:
+    """A job's pinhole camera standing at ``position`` with focal length ``f`` and principal
+    point ``center`` (pixels), turned by ``Rs``: one world-to-camera rotation, or one per
+    frame for a camera that turns (R and t then given per frame)."""
     K = [[f, 0.0, center[0]], [0.0, f, center[1]], [0.0, 0.0, 1.0]]
-    if pans is None:
-        return {"model": "pinhole", "K": K, "R": R.tolist(), "t": (-R @ position).tolist()}
-    Rs = [panned(R, a) for a in pans]
-    return {"model": "pinhole", "K": K, "R": [r.tolist() for r in Rs],
-            "t": [(-r @ position).tolist() for r in Rs]}
+    R, t = [r.tolist() for r in Rs], [(-r @ position).tolist() for r in Rs]
+    return {"model": "pinhole", "K": K, "R": R if len(Rs) > 1 else R[0],
+            "t": t if len(Rs) > 1 else t[0]}
 
 
 def cloth_colour(P: np.ndarray, seed: int = 7) -> np.ndarray:
