@@ -13,6 +13,13 @@ than the light backdrop, specks removed, the largest piece), beside the first fr
 carried along with the tracked body (its root and view as tracked, its joints as clicked).
 The tail is not modelled, so even the first frame's overlap is well under 1: the measure is
 the tracked frames against the first.
+
+Scored too against points clicked by hand on every frame (``"scored"`` in the clicks file):
+the snout and the feet that can be told apart, fore and hind. Which foot of a pair is the
+near one cannot be read off every frame of a small print, so a pair of clicked feet is
+matched to the body's pair of the same end (fore or hind) the way that puts them nearer,
+and one clicked foot to the nearer of the two. Distances are in % of the body's length (the
+first frame's clicked rump to snout).
 """
 
 from __future__ import annotations
@@ -115,6 +122,41 @@ def overlap(sk: Skeleton, pose: BodyPose, sil: np.ndarray) -> float:
     return float((covered & sil).sum() / max((covered | sil).sum(), 1))
 
 
+FEET = {"fore": ("LeftForeLower", "RightForeLower"), "hind": ("LeftHindLower", "RightHindLower")}
+
+
+def body_length(spec: dict) -> float:
+    """Pixels from the rump (the trunk's clicked joint) to the snout on the first frame."""
+    return float(np.linalg.norm(np.subtract(spec["clicks"]["Head/end"], spec["clicks"]["Trunk"])))
+
+
+def tips(sk: Skeleton, pose: BodyPose) -> dict[str, np.ndarray]:
+    """Where the snout and the four feet (their bones' end sites) fall in the one view."""
+    M = sk.joint_frames(pose.rotations, pose.root_position)
+    out = {}
+    for name in ("Head", *FEET["fore"], *FEET["hind"]):
+        j = sk.index(name)
+        tip = M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3]
+        out[name] = pose.views[0].project(tip[None])[0]
+    return out
+
+
+def click_distances(clicked: dict, at: dict[str, np.ndarray]) -> list[float]:
+    """Pixel distances of one frame's clicked snout and feet (``"scored"`` entry) to the
+    body's ``tips``; each clicked pair of feet matched to the body's pair as puts them
+    nearer, a lone clicked foot to the nearer of the two."""
+    out = [float(np.linalg.norm(np.subtract(clicked["snout"], at["Head"])))]
+    for end, names in FEET.items():
+        feet = np.asarray(clicked.get(end, []), float).reshape(-1, 2)
+        ours = np.array([at[n] for n in names])
+        d = np.linalg.norm(feet[:, None] - ours[None], axis=2)  # clicked x body
+        if len(feet) == 2:
+            out += list(min((d[0, 0], d[1, 1]), (d[0, 1], d[1, 0]), key=sum))
+        elif len(feet) == 1:
+            out.append(float(d[0].min()))
+    return [float(x) for x in out]
+
+
 @dataclass
 class FrameScore:
     frame: int  # 1-based, the plate's reading order
@@ -122,6 +164,9 @@ class FrameScore:
     carried: float  # the first frame's pose carried along with the body
     flagged: dict  # the tracker's limb flags there
     diverged: bool
+    clicks: float = float("nan")  # the clicked points' mean distance, % of the body's length
+    clicks_worst: float = float("nan")  # the farthest clicked point, % of the body's length
+    clicks_carried: float = float("nan")  # the mean for the first pose carried along
 
 
 def run(name: str) -> list[FrameScore]:
@@ -138,13 +183,21 @@ def run(name: str) -> list[FrameScore]:
     for fr in result.frames:
         sil = silhouette(greys[fr.frame])
         carried = BodyPose(first.rotations, fr.pose.root_position, fr.pose.views)
-        scores.append(_score(sk, fr, sil, carried))
+        scores.append(_score(sk, fr, sil, carried, spec))
     return scores
 
 
-def _score(sk: Skeleton, fr: FrameResult, sil: np.ndarray, carried: BodyPose) -> FrameScore:
-    return FrameScore(fr.frame + 1, overlap(sk, fr.pose, sil), overlap(sk, carried, sil),
-                      fr.flagged, fr.diverged)
+def _score(sk: Skeleton, fr: FrameResult, sil: np.ndarray, carried: BodyPose,
+           spec: dict) -> FrameScore:
+    score = FrameScore(fr.frame + 1, overlap(sk, fr.pose, sil), overlap(sk, carried, sil),
+                       fr.flagged, fr.diverged)
+    clicked = spec.get("scored", {}).get(str(fr.frame + 1))
+    if clicked:
+        unit = 100.0 / body_length(spec)
+        ours = np.array(click_distances(clicked, tips(sk, fr.pose))) * unit
+        score.clicks, score.clicks_worst = float(ours.mean()), float(ours.max())
+        score.clicks_carried = float(np.mean(click_distances(clicked, tips(sk, carried))) * unit)
+    return score
 
 
 def main(argv=None) -> int:
@@ -153,14 +206,20 @@ def main(argv=None) -> int:
     for name in names:
         scores = run(name)
         print(f"\n{name}: overlap with the silhouette (the first frame's {scores[0].tracked:.2f})")
-        print("| frame | tracked | first pose carried | limbs flagged |\n|---|---|---|---|")
+        print("| frame | overlap: tracked | first pose carried | clicked points: tracked (worst)"
+              " | first pose carried | limbs flagged |\n|---|---|---|---|---|---|")
         for s in scores:
-            print(f"| {s.frame} | {s.tracked:.2f} | {s.carried:.2f} |"
+            print(f"| {s.frame} | {s.tracked:.2f} | {s.carried:.2f} | {s.clicks:.1f} %"
+                  f" ({s.clicks_worst:.1f} %) | {s.clicks_carried:.1f} % |"
                   f" {', '.join(s.flagged) or ''}{' (diverged)' if s.diverged else ''} |")
         later = scores[1:]
         print(f"tracked frames: worst {min(s.tracked for s in later):.2f}, mean "
               f"{np.mean([s.tracked for s in later]):.2f}; first pose carried: mean "
               f"{np.mean([s.carried for s in later]):.2f}")
+        print(f"clicked points (% of the body's length): tracked mean "
+              f"{np.nanmean([s.clicks for s in later]):.1f}, worst frame "
+              f"{np.nanmax([s.clicks for s in later]):.1f}; first pose carried: mean "
+              f"{np.nanmean([s.clicks_carried for s in later]):.1f}")
     return 0
 
 
