@@ -55,17 +55,20 @@ PARENT = {"Trunk": None, "Neck": "Trunk", "Head": "Neck",
 
 
 def planar_body(spec: dict, unit: float = 1.0) -> tuple[Skeleton, BodyPose]:
-    """The quadruped of ``spec`` (clicks, radii, side_apart: pixels) and its pose on the
-    first frame: the rest pose, every rotation the identity, seen by an orthographic view
-    looking along -z (world y up, image y down) at ``unit`` world units per pixel, whose
-    pixel (0, 0) is the world's origin."""
-    clicks, apart = spec["clicks"], spec["side_apart"]
+    """The quadruped of ``spec`` (clicks, radii, side_apart: pixels; near: the side facing
+    the camera, Left unless said) and its pose on the first frame: the rest pose, every
+    rotation the identity, seen by an orthographic view looking along -z (world y up,
+    image y down) at ``unit`` world units per pixel, whose pixel (0, 0) is the world's
+    origin."""
+    clicks, near = spec["clicks"], spec.get("near", "Left")
+    apart = spec["side_apart"]
     r = {k: np.asarray(v, float) * unit for k, v in spec["radii"].items()}
 
     def at(name: str) -> np.ndarray:
         x, y = clicks[name]
         side = name.split("/")[0]
-        z = apart if side.startswith("Left") else -apart if side.startswith("Right") else 0
+        z = (apart if side.startswith(near) else -apart) if side.startswith(
+            ("Left", "Right")) else 0
         return np.array([x, -y, z], float) * unit
 
     names = list(PARENT)
@@ -216,6 +219,8 @@ def main(argv=None) -> int:
         print(f"tracked frames: worst {min(s.tracked for s in later):.2f}, mean "
               f"{np.mean([s.tracked for s in later]):.2f}; first pose carried: mean "
               f"{np.mean([s.carried for s in later]):.2f}")
+        if "scored" not in json.loads((DATA / f"{name}.json").read_text()):
+            continue
         print(f"clicked points (% of the body's length): tracked mean "
               f"{np.nanmean([s.clicks for s in later]):.1f}, worst frame "
               f"{np.nanmax([s.clicks for s in later]):.1f}; first pose carried: mean "

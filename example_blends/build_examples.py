@@ -12,11 +12,15 @@ camera, and the planar quadruped template placed and scaled over the horse on pl
 muybridge_woman.blend: a woman jumping, with the 19-degree-of-freedom human placed over her.
 Their limbs are left for the user to pose over the first plate; both track side-on (one view).
 
-muybridge_baboon.blend, muybridge_camel.blend: a printed plate of muybridge_plates/ cut into
-its cells by Add View from Plate (the frames in muybridge_plates/plate_NAME_frames/), and the
-planar quadruped of bench/plates.py standing on the joints clicked on its first frame
-(bench/data/plates/NAME.json; the clicks are the view's markers there, so Fit Pose to
-Markers gives the pose back), a centimetre per pixel: ready for Track.
+muybridge_baboon.blend, muybridge_camel.blend, muybridge_mule.blend: a printed plate of
+muybridge_plates/ cut into its cells by Add View from Plate (the frames in
+muybridge_plates/plate_NAME_frames/), and the planar quadruped of bench/plates.py standing on
+the joints clicked on its first frame (bench/data/plates/NAME.json; the clicks are the view's
+markers there, so Fit Pose to Markers gives the pose back), a centimetre per pixel; tracked
+from there through the real Track operator, with a volumetric body riding on it. The baboon's
+and the camel's walks are also made into a cycle, an action of its own in the file, exported
+as muybridge_plates/NAME_cycle.bvh and .fbx; the mule bucks, which is no gait. Each scene's
+text 'About this example' says what it holds.
 
 Paths are relative to each .blend, so the folder can move.
 """
@@ -118,9 +122,11 @@ def pose_on_plate(scene, twist_addon, spec: dict, name: str):
     return arm
 
 
-def build_plate(bpy, twist_addon, name: str) -> Path:
+def build_plate(bpy, twist_addon, name: str, gait: bool) -> Path:
     """A printed plate cut into a view, with the planar quadruped clicked on its first frame
-    (see the module's docstring)."""
+    (see the module's docstring), tracked through the real operators from that pose, a
+    volumetric body riding on it; for a ``gait``, the track made into a cycle kept as its own
+    action and exported as BVH and FBX beside the plate."""
     import json
 
     spec = json.loads((PLATE_CLICKS / f"{name}.json").read_text())
@@ -129,13 +135,60 @@ def build_plate(bpy, twist_addon, name: str) -> Path:
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
     scene = bpy.context.scene
-    pose_on_plate(scene, twist_addon, spec, name)
+    arm = pose_on_plate(scene, twist_addon, spec, name)
     scene.render.fps = 15
     cam = scene.twist.views[0].camera
     scene.camera = cam
     scene.frame_set(1)
+    assert bpy.ops.twist.track() == {"FINISHED"}, name
+    assert bpy.ops.twist.add_volumetric_body() == {"FINISHED"}, name
+    about = ABOUT_PLATE.format(name=name, frames=scene.frame_end,
+                               tracked=scene.twist.result.frames_tracked + 1)
+    if gait:
+        about += ABOUT_CYCLE.format(name=name)
+        make_cycle(bpy, scene, arm, HERE / "muybridge_plates" / f"{name}_cycle")
+    else:
+        about += ABOUT_NO_CYCLE
+    bpy.data.texts.new("About this example").write(about)
+    scene.frame_set(1)
     bpy.ops.wm.save_as_mainfile(filepath=str(path), relative_remap=True)
     return path
+
+
+ABOUT_PLATE = """Muybridge's plate of the {name} (example_blends/muybridge_plates/), cut into its
+{frames} cells by Add View from Plate. The quadruped stands on the joints clicked by hand on
+the first frame (the view's markers there; Fit Pose to Markers gives the pose back). Track
+ran from frame 1, side-on (one view), and kept frames 1-{tracked}; the Results panel lists
+the frames whose limbs it is unsure of. The volumetric body (collection Twist body) rides on
+the armature. To track again: Clear Track, go to frame 1, Track.
+"""
+ABOUT_CYCLE = """
+The plate holds about one stride: Make Walk Cycle (the frame range as one cycle) made the
+track into the action '{name} cycle', kept in this file (pick it in the Action editor to
+watch it loop), exported as muybridge_plates/{name}_cycle.bvh and .fbx.
+"""
+ABOUT_NO_CYCLE = """
+A buck is not a gait, so no cycle is made of it: the track holds the frames the tracker
+could follow, and stops where it cannot.
+"""
+
+
+def make_cycle(bpy, scene, arm, stem: Path) -> None:
+    """Make the armature's track, over the scene's range taken as one cycle, into a looping
+    action of its own (named '<armature> cycle', kept in the file) and export that cycle
+    as ``stem``.bvh and .fbx; the armature keeps its tracked action."""
+    tracked = arm.animation_data.action
+    cycle = tracked.copy()
+    cycle.name = f"{arm.name.lower()} cycle"
+    cycle.use_fake_user = True
+    slot = arm.animation_data.action_slot.identifier
+    arm.animation_data.action = cycle
+    arm.animation_data.action_slot = cycle.slots[slot]
+    assert bpy.ops.twist.make_cycle(range_is_cycle=True) == {"FINISHED"}
+    for ext, op in ((".bvh", bpy.ops.twist.export_bvh), (".fbx", bpy.ops.twist.export_fbx)):
+        assert op(filepath=str(stem.with_suffix(ext)), only_cycle=True) == {"FINISHED"}
+    arm.animation_data.action = tracked
+    arm.animation_data.action_slot = tracked.slots[slot]
 
 
 def main() -> int:
@@ -151,8 +204,8 @@ def main() -> int:
     # metre down the plates (padded to 202 x 376); the human turned to face the image's right
     print(build_plates(bpy, "muybridge_woman", "HUMAN", 376 / 160, (0.097125, -10.0, 0.984375),
                        turn_deg=90))
-    for name in ("baboon", "camel"):
-        print(build_plate(bpy, addon.twist_addon, name))
+    for name, gait in (("baboon", True), ("camel", True), ("mule", False)):
+        print(build_plate(bpy, addon.twist_addon, name, gait))
     return 0
 
 

@@ -17,6 +17,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "example_blends"
     ("muybridge_woman.blend", 1, 10, "INDEPENDENT"),
     ("muybridge_baboon.blend", 1, 12, "INDEPENDENT"),
     ("muybridge_camel.blend", 1, 10, "INDEPENDENT"),
+    ("muybridge_mule.blend", 1, 8, "INDEPENDENT"),
 ])
 def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, frames, mode):
     bpy = bpy_module
@@ -86,3 +87,34 @@ def test_a_plates_example_stands_on_its_clicks_and_tracks_through(bpy_module, re
         pb.rotation_euler[2] = 0.0
     assert bpy.ops.twist.track() == {"FINISHED"}
     assert scene.twist.result.frames_tracked == 9 and not scene.twist.result.diverged_frames
+
+
+@pytest.mark.parametrize("name, cells", [("baboon", 12), ("camel", 10)])
+def test_a_walking_plates_example_holds_its_track_body_and_exported_cycle(
+        bpy_module, registered, name, cells):
+    """Built by ``build_examples.py``: the track keyed on the armature, a volumetric body
+    parented to its bones, the cycle as an action of its own beside the tracked one, and
+    that cycle exported next to the plate, read back by the project's reader and by
+    Blender's BVH and FBX importers."""
+    bpy = bpy_module
+    scene, arm, *_ = one_view_example(bpy, registered, f"muybridge_{name}.blend")
+    assert scene.twist.result.frames_tracked >= 8
+    body = bpy.data.collections["Twist body"].objects
+    bones = {b.name for b in arm.data.bones}
+    assert len(body) >= 11 and all(o.parent == arm and o.parent_bone in bones for o in body)
+    tracked = arm.animation_data.action
+    cycle = bpy.data.actions[f"{name} cycle"]
+    assert cycle.use_fake_user and tracked != cycle
+    bag = registered.twist_addon.keyframes.channelbag(arm)
+    assert not any(m.type == "CYCLES" for fc in bag.fcurves for m in fc.modifiers)
+
+    stem = EXAMPLES / "muybridge_plates" / f"{name}_cycle"
+    got = registered.core.bvh.read_bvh(stem.with_suffix(".bvh"))
+    assert len(got.motion) == cells and set(got.names) == bones
+    for importer, ext in ((bpy.ops.import_anim.bvh, ".bvh"), (bpy.ops.import_scene.fbx, ".fbx")):
+        before = set(bpy.data.objects)
+        assert importer(filepath=str(stem.with_suffix(ext))) == {"FINISHED"}
+        back = next(o for o in set(bpy.data.objects) - before if o.type == "ARMATURE")
+        assert {b.name for b in back.data.bones} >= bones
+        first, last = back.animation_data.action.frame_range
+        assert last - first >= cells - 1, ext
