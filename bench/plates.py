@@ -177,7 +177,10 @@ def run(name: str) -> list[FrameScore]:
     spec = json.loads((DATA / f"{name}.json").read_text())
     sk, first = planar_body(spec)
     with tempfile.TemporaryDirectory() as tmp:
-        _, paths = write_frames(ROOT / spec["plate"], tmp)
+        if "plate" in spec:
+            _, paths = write_frames(ROOT / spec["plate"], tmp)
+        else:  # frames already cut
+            paths = sorted((ROOT / spec["frames"]).glob("*.png"))
         with quiet_stderr():
             greys = [load_grey(p) for p in paths]
     tracker = Tracker(sk, [greys], INDEPENDENT)

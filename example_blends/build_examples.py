@@ -7,20 +7,20 @@ capture's armature posed on frame 1 with its lower back free as well as the pape
 degrees of freedom (bench/walk_footage.py's SPINE_JOINTS), ready for Track. The capture's
 frames that were rendered are kept as walk_3view/truth.bvh.
 
-muybridge_horse.blend: Muybridge's "Sallie Gardner at a Gallop" plates behind one orthographic
-camera, and the planar quadruped template placed and scaled over the horse on plate 1;
-muybridge_woman.blend: a woman jumping, with the 19-degree-of-freedom human placed over her.
-Their limbs are left for the user to pose over the first plate; both track side-on (one view).
+muybridge_woman.blend: Muybridge's woman jumping behind one orthographic camera, with the
+19-degree-of-freedom human placed over her on the first frame; her skirt hides her legs, so
+she is left for the user (its text 'About this example' says why).
 
 muybridge_baboon.blend, muybridge_camel.blend, muybridge_mule.blend: a printed plate of
 muybridge_plates/ cut into its cells by Add View from Plate (the frames in
-muybridge_plates/plate_NAME_frames/), and the planar quadruped of bench/plates.py standing on
-the joints clicked on its first frame (bench/data/plates/NAME.json; the clicks are the view's
-markers there, so Fit Pose to Markers gives the pose back), a centimetre per pixel; tracked
-from there through the real Track operator, with a volumetric body riding on it. The baboon's
-and the camel's walks are also made into a cycle, an action of its own in the file, exported
-as muybridge_plates/NAME_cycle.bvh and .fbx; the mule bucks, which is no gait. Each scene's
-text 'About this example' says what it holds.
+muybridge_plates/plate_NAME_frames/); muybridge_horse.blend: "Sallie Gardner at a Gallop",
+its frames already cut (muybridge_horse/). Each with the planar quadruped of bench/plates.py
+standing on the joints clicked on its first frame (bench/data/plates/NAME.json; the clicks
+are the view's markers there, so Fit Pose to Markers gives the pose back), a centimetre per
+pixel; tracked from there through the real Track operator, with a volumetric body riding on
+it. The horse's, the baboon's and the camel's strides are also made into a cycle, an action
+of its own in the file, exported as exports/NAME_cycle.bvh and .fbx; the mule bucks, which
+is no gait. Each scene's text 'About this example' says what it holds.
 
 Paths are relative to each .blend, so the folder can move.
 """
@@ -49,6 +49,7 @@ from walk_footage import SPINE_JOINTS, render, tracking_scene  # noqa: E402
 WALK = dict(first=540, last=660, step=8)  # capture frames: one second at 15 fps
 VIEWS = ["lateral", "endon", "oblique60"]
 PLATE_UNIT = 0.01  # metres per pixel of a plate's frames: the animals about a metre long
+EXPORTS = HERE / "exports"  # the plate examples' cycles as BVH and FBX
 
 
 def build_walk(bpy) -> Path:
@@ -76,30 +77,41 @@ def build_walk(bpy) -> Path:
     return path
 
 
-def build_plates(bpy, name: str, template: str, ortho_scale: float, location: tuple,
-                 turn_deg: float = 0.0) -> Path:
-    """One view of the Muybridge plates in ``example_blends/NAME/`` (see SOURCES.md) with a
-    template armature placed over the subject."""
-    out = HERE / name
+def build_woman(bpy) -> Path:
+    """The woman jumping behind one orthographic camera, with the 19-degree-of-freedom human
+    placed over her on the first frame (hips near (85, 193), feet on the frames' bottom, 160
+    pixels per metre down the frames, padded to 202 x 376; turned to face the image's
+    right), its limbs left for the user, and a text saying why it is not tracked here."""
+    out = HERE / "muybridge_woman"
     files = sorted(out.glob("*.png"))
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    path = HERE / f"{name}.blend"
+    path = HERE / "muybridge_woman.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
-    bpy.ops.twist.add_view(filepath=str(out / files[0].name), first_frame=1)
+    bpy.ops.twist.add_view(filepath=str(files[0]), first_frame=1)
     scene = bpy.context.scene
     cam = scene.twist.views[0].camera
-    cam.data.ortho_scale = ortho_scale
-    cam.location = location
-    bpy.ops.twist.add_template_armature(template=template)
-    scene.twist.armature.rotation_euler[2] = np.radians(turn_deg)
+    cam.data.ortho_scale = 376 / 160
+    cam.location = (0.097125, -10.0, 0.984375)
+    bpy.ops.twist.add_template_armature(template="HUMAN")
+    scene.twist.armature.rotation_euler[2] = np.radians(90)
     scene.twist.mode = "INDEPENDENT"
     scene.twist.tracker.side_on = True  # one view of a body seen from the side
     scene.frame_start, scene.frame_end = 1, len(files)
     scene.render.fps = 15
     scene.camera = cam
+    bpy.data.texts.new("About this example").write(ABOUT_WOMAN)
     scene.frame_set(1)
     bpy.ops.wm.save_as_mainfile(filepath=str(path), relative_remap=True)
     return path
+
+
+ABOUT_WOMAN = """Muybridge's woman jumping (example_blends/muybridge_woman/), added with Add
+View, and the human template placed over her on the first frame, not posed and not tracked
+here: her long skirt hides the hips, thighs and knees on every frame, and the digitised
+frames have the figure cut out onto black, so there is neither a leg to click nor a
+backdrop to hold a silhouette against. Pose the arms, head and trunk over the first frame
+(Place Markers, Fit Pose to Markers) to try; Track flags the frames it is unsure of.
+"""
 
 
 def pose_on_plate(scene, twist_addon, spec: dict, name: str):
@@ -123,17 +135,22 @@ def pose_on_plate(scene, twist_addon, spec: dict, name: str):
 
 
 def build_plate(bpy, twist_addon, name: str, gait: bool) -> Path:
-    """A printed plate cut into a view, with the planar quadruped clicked on its first frame
-    (see the module's docstring), tracked through the real operators from that pose, a
-    volumetric body riding on it; for a ``gait``, the track made into a cycle kept as its own
-    action and exported as BVH and FBX beside the plate."""
+    """A printed plate cut into a view (or frames already cut, added as they are), with the
+    planar quadruped clicked on its first frame (see the module's docstring), tracked through
+    the real operators from that pose, a volumetric body riding on it; for a ``gait``, the
+    track made into a cycle kept as its own action and exported as BVH and FBX into
+    ``EXPORTS``."""
     import json
 
     spec = json.loads((PLATE_CLICKS / f"{name}.json").read_text())
     bpy.ops.wm.read_factory_settings(use_empty=True)
     path = HERE / f"muybridge_{name}.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
-    bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
+    if "plate" in spec:
+        bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
+    else:  # frames already cut
+        first = sorted((ROOT / spec["frames"]).glob("*.png"))[0]
+        bpy.ops.twist.add_view(filepath=str(first), first_frame=1)
     scene = bpy.context.scene
     arm = pose_on_plate(scene, twist_addon, spec, name)
     scene.render.fps = 15
@@ -142,11 +159,12 @@ def build_plate(bpy, twist_addon, name: str, gait: bool) -> Path:
     scene.frame_set(1)
     assert bpy.ops.twist.track() == {"FINISHED"}, name
     assert bpy.ops.twist.add_volumetric_body() == {"FINISHED"}, name
-    about = ABOUT_PLATE.format(name=name, frames=scene.frame_end,
-                               tracked=scene.twist.result.frames_tracked + 1)
+    about = ((ABOUT_PLATE if "plate" in spec else ABOUT_FRAMES) + ABOUT_TRACKED).format(
+        name=name, source=spec.get("plate", spec.get("frames")), frames=scene.frame_end,
+        tracked=scene.twist.result.frames_tracked + 1)
     if gait:
         about += ABOUT_CYCLE.format(name=name)
-        make_cycle(bpy, scene, arm, HERE / "muybridge_plates" / f"{name}_cycle")
+        make_cycle(bpy, scene, arm, EXPORTS / f"{name}_cycle")
     else:
         about += ABOUT_NO_CYCLE
     bpy.data.texts.new("About this example").write(about)
@@ -155,17 +173,20 @@ def build_plate(bpy, twist_addon, name: str, gait: bool) -> Path:
     return path
 
 
-ABOUT_PLATE = """Muybridge's plate of the {name} (example_blends/muybridge_plates/), cut into its
-{frames} cells by Add View from Plate. The quadruped stands on the joints clicked by hand on
-the first frame (the view's markers there; Fit Pose to Markers gives the pose back). Track
-ran from frame 1, side-on (one view), and kept frames 1-{tracked}; the Results panel lists
-the frames whose limbs it is unsure of. The volumetric body (collection Twist body) rides on
-the armature. To track again: Clear Track, go to frame 1, Track.
+ABOUT_PLATE = """Muybridge's plate of the {name} ({source}), cut into its {frames} cells by
+Add View from Plate."""
+ABOUT_FRAMES = """Muybridge's {name} ({source}/, {frames} frames as digitised), added with Add
+View; the rider is not modelled."""
+ABOUT_TRACKED = """ The quadruped stands on the joints clicked by hand on the first frame
+(the view's markers there; Fit Pose to Markers gives the pose back). Track ran from frame
+1, side-on (one view), and kept frames 1-{tracked}; the Results panel lists the frames whose
+limbs it is unsure of. The volumetric body (collection Twist body) rides on the armature. To
+track again: Clear Track, go to frame 1, Track.
 """
 ABOUT_CYCLE = """
-The plate holds about one stride: Make Walk Cycle (the frame range as one cycle) made the
+The frames hold about one stride: Make Walk Cycle (the frame range as one cycle) made the
 track into the action '{name} cycle', kept in this file (pick it in the Action editor to
-watch it loop), exported as muybridge_plates/{name}_cycle.bvh and .fbx.
+watch it loop), exported as exports/{name}_cycle.bvh and .fbx.
 """
 ABOUT_NO_CYCLE = """
 A buck is not a gait, so no cycle is made of it: the track holds the frames the tracker
@@ -185,6 +206,7 @@ def make_cycle(bpy, scene, arm, stem: Path) -> None:
     arm.animation_data.action = cycle
     arm.animation_data.action_slot = cycle.slots[slot]
     assert bpy.ops.twist.make_cycle(range_is_cycle=True) == {"FINISHED"}
+    stem.parent.mkdir(exist_ok=True)
     for ext, op in ((".bvh", bpy.ops.twist.export_bvh), (".fbx", bpy.ops.twist.export_fbx)):
         assert op(filepath=str(stem.with_suffix(ext)), only_cycle=True) == {"FINISHED"}
     arm.animation_data.action = tracked
@@ -197,14 +219,8 @@ def main() -> int:
     addon = load_addon()
     addon.register()  # its classes outlive the factory resets below
     print(build_walk(bpy))
-    # the horse: the quadruped's trunk along the barrel (rump at (88, 92)), its poll near the
-    # ears, 70 px per metre across the 300 x 200 plates
-    print(build_plates(bpy, "muybridge_horse", "QUADRUPED", 300 / 70.2, (0.076, -10.0, 1.193)))
-    # the woman (facing right): hips near (85, 193) and feet on the plate's bottom, 160 px per
-    # metre down the plates (padded to 202 x 376); the human turned to face the image's right
-    print(build_plates(bpy, "muybridge_woman", "HUMAN", 376 / 160, (0.097125, -10.0, 0.984375),
-                       turn_deg=90))
-    for name, gait in (("baboon", True), ("camel", True), ("mule", False)):
+    print(build_woman(bpy))
+    for name, gait in (("horse", True), ("baboon", True), ("camel", True), ("mule", False)):
         print(build_plate(bpy, addon.twist_addon, name, gait))
     return 0
 
