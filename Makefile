@@ -45,9 +45,10 @@ bench-real: venv
 bench-quick: venv
 	$(PY) bench/suite.py --quick $(BENCH_ARGS)
 
-# Muybridge's printed plates tracked from clicked first poses, scored on the animal's outline.
+# Muybridge's plates tracked from clicked first poses, scored on the animal's outline and on
+# points clicked on every frame; writes docs/PLATES.md.
 bench-plates: venv
-	$(PY) bench/plates.py
+	$(PY) bench/plates.py --write docs/PLATES.md
 
 # The one-clip walk benchmark with its references for one view and one step.
 bench-walk: venv

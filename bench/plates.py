@@ -1,6 +1,6 @@
 """Muybridge's printed plates tracked end to end and measured against the animal's outline.
 
-    python bench/plates.py [NAME ...]
+    python bench/plates.py [NAME ...] [--write docs/PLATES.md]
 
 For each plate with clicks in ``bench/data/plates/NAME.json``: the plate is cut into its
 cells (``core.plate``), a planar quadruped is built from the joints clicked on the first
@@ -24,10 +24,12 @@ first frame's clicked rump to snout).
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 import tempfile
 from dataclasses import dataclass
+from datetime import date
 from pathlib import Path
 
 import cv2
@@ -206,29 +208,60 @@ def _score(sk: Skeleton, fr: FrameResult, sil: np.ndarray, carried: BodyPose,
     return score
 
 
+def report(name: str, scores: list[FrameScore]) -> list[str]:
+    """Markdown for one plate's run: a summary line, and per frame the outline's overlap, the
+    clicked points' distance and the limbs flagged, beside the first pose carried along."""
+    later = scores[1:]
+    clicked = not np.isnan(scores[0].clicks)
+    worst = min(s.tracked for s in later)
+    lines = [f"**{name}** ({len(scores)} frames tracked): the outline's overlap with the "
+             f"silhouette {scores[0].tracked:.2f} on the first frame, then worst {worst:.2f} "
+             f"({worst / scores[0].tracked:.2f}x the first's), mean "
+             f"{np.mean([s.tracked for s in later]):.2f}; the first pose carried along: mean "
+             f"{np.mean([s.carried for s in later]):.2f}."]
+    if clicked:
+        lines[-1] += (f" Clicked snout and feet: mean {np.nanmean([s.clicks for s in later]):.1f}"
+                      f" % of the body's length, worst frame "
+                      f"{np.nanmax([s.clicks for s in later]):.1f} %; the first pose carried "
+                      f"along: {np.nanmean([s.clicks_carried for s in later]):.1f} %.")
+    lines += ["", "| frame | overlap: tracked | first pose carried | clicked points: tracked "
+              "(farthest) | first pose carried | limbs flagged |", "|---|---|---|---|---|---|"]
+    for s in scores:
+        points = (f"{s.clicks:.1f} % ({s.clicks_worst:.1f} %) | {s.clicks_carried:.1f} %"
+                  if clicked else " | ")
+        lines.append(f"| {s.frame} | {s.tracked:.2f} | {s.carried:.2f} | {points} |"
+                     f" {', '.join(s.flagged)}{' (diverged)' if s.diverged else ''} |")
+    return lines + [""]
+
+
 def main(argv=None) -> int:
-    names = (argv if argv is not None else sys.argv[1:]) or sorted(
-        p.stem for p in DATA.glob("*.json"))
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("names", nargs="*", help="plates (bench/data/plates/NAME.json); all if none")
+    ap.add_argument("--write", type=Path, help="also write the results as markdown here")
+    a = ap.parse_args(argv)
+    names = a.names or sorted(p.stem for p in DATA.glob("*.json"))
+    lines = [f"# Muybridge's plates\n\nWritten by `make bench-plates` (`bench/plates.py`) on "
+             f"{date.today().isoformat()}. {HOW}\n"]
     for name in names:
-        scores = run(name)
-        print(f"\n{name}: overlap with the silhouette (the first frame's {scores[0].tracked:.2f})")
-        print("| frame | overlap: tracked | first pose carried | clicked points: tracked (worst)"
-              " | first pose carried | limbs flagged |\n|---|---|---|---|---|---|")
-        for s in scores:
-            print(f"| {s.frame} | {s.tracked:.2f} | {s.carried:.2f} | {s.clicks:.1f} %"
-                  f" ({s.clicks_worst:.1f} %) | {s.clicks_carried:.1f} % |"
-                  f" {', '.join(s.flagged) or ''}{' (diverged)' if s.diverged else ''} |")
-        later = scores[1:]
-        print(f"tracked frames: worst {min(s.tracked for s in later):.2f}, mean "
-              f"{np.mean([s.tracked for s in later]):.2f}; first pose carried: mean "
-              f"{np.mean([s.carried for s in later]):.2f}")
-        if "scored" not in json.loads((DATA / f"{name}.json").read_text()):
-            continue
-        print(f"clicked points (% of the body's length): tracked mean "
-              f"{np.nanmean([s.clicks for s in later]):.1f}, worst frame "
-              f"{np.nanmax([s.clicks for s in later]):.1f}; first pose carried: mean "
-              f"{np.nanmean([s.clicks_carried for s in later]):.1f}")
+        lines += report(name, run(name))
+    text = "\n".join(lines)
+    print(text)
+    if a.write:
+        a.write.write_text(text)
     return 0
+
+
+HOW = ("Each plate is tracked with the default settings, side-on in its one view, from the "
+       "planar quadruped standing on the joints clicked on its first frame "
+       "(`bench/data/plates/`). The overlap is the intersection over union of the tracked "
+       "blobs' outline with the animal's silhouette (the tail is not modelled, so even the "
+       "first frame's is well under 1). The clicked points are the snout and the feet clicked "
+       "by hand on every frame, a clicked pair of feet matched to the body's fore or hind pair "
+       "the nearer way, in % of the body's length (rump to snout on the first frame); on the "
+       "first frame they measure the clicking itself. 'First pose carried' is the first "
+       "frame's pose moved along with the tracked body (its root and view as tracked). The "
+       "horse's rider and the mule's buck are not modelled; the mule's run stops where it "
+       "diverges.")
 
 
 if __name__ == "__main__":
