@@ -159,11 +159,13 @@ class SilhouetteCue:
     """One run's silhouette state: each view's backdrop, learned from the key frame the
     first time it is asked for and then from every tracked frame, and the foregrounds of
     the frame being tracked. The tracker says where the body is (its blobs' pixels, full
-    resolution); this object knows only images. A view whose footage around the body keeps
-    changing (a moving camera or light) has no backdrop, and a note says so."""
+    resolution); this object knows only images. A view whose camera is known to move, or
+    whose footage around the body keeps changing (a camera or light moving unannounced),
+    has no backdrop, and a note says so."""
 
-    def __init__(self, seq):
+    def __init__(self, seq, moving: Iterable[int] = ()):
         self.seq = seq  # the run's ImageSequence
+        self.moving = frozenset(moving)  # views whose camera moves
         self.backdrops: list[Backdrop | None] | None = None  # per view; None: not started
         self._foregrounds: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
 
@@ -182,6 +184,11 @@ class SilhouetteCue:
         others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
         self.backdrops, notes = [], []
         for c, (body, margin) in enumerate(zip(bodies, margins)):
+            if c in self.moving:
+                notes.append(f"view {c + 1}: its camera moves, and the backdrop with it, so "
+                             "its silhouette is not used")
+                self.backdrops.append(None)
+                continue
             backdrop = Backdrop(self.seq.grey(c, key_frame), body, (
                 self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})), margin)
             if not backdrop.still:

@@ -20,6 +20,7 @@ import numpy as np
 
 from . import image as imagelib
 from . import se3
+from . import silhouette as sil
 from .blas import one_blas_thread
 from .camera import Camera
 from .confidence import UNSEEN
@@ -83,6 +84,9 @@ class Tracker(FrameFit):
             if path is not None and len(path) < self.seq.n_frames():
                 raise InputError(f"view {c + 1}'s camera is given on {len(path)} frames, its "
                                  f"footage has {self.seq.n_frames()}")
+        # a moving camera's backdrop moves with it: no silhouette for that view
+        self._cue = sil.SilhouetteCue(self.seq, [c for c, m in enumerate(self.moving)
+                                                 if m is not None])
 
     def _filmed_from(self, pose: BodyPose, frame: int) -> BodyPose:
         """``pose`` seen through each view's camera as it stood on ``frame``."""

@@ -474,9 +474,13 @@ def test_a_camera_that_pans_is_followed_frame_by_frame(pinhole_footage, tmp_path
     for name, cam in (("panning", pan), ("told_still", dict(pan, R=pan["R"][0], t=pan["t"][0]))):
         (folder / f"{name}.json").write_text(json.dumps(dict(job, views=[
             dict(views[0], camera=cam)] + views[1:])))
-        out = tmp_path / f"{name}.bvh"
-        proc = _run("track", folder / f"{name}.json", "--out", out)
+        out, report = tmp_path / f"{name}.bvh", tmp_path / f"{name}.report.json"
+        proc = _run("track", folder / f"{name}.json", "--out", out, "--report", report)
         assert proc.returncode in (0, 3), proc.stderr
+        notes = json.loads(report.read_text())["notes"]
+        # the panning view's backdrop moves with it: only the still views' silhouettes count
+        assert any(n.startswith("view 1: its camera moves") for n in notes) == (
+            name == "panning"), notes
         R_got, p_got = read_bvh(out).poses()
         n = len(R_got)
         legs = _leg_errors(loaded.skeleton, (R_got, p_got), (R[:n], p[:n]))
