@@ -6,7 +6,7 @@ backdrop (Muybridge's ruled black, a bright brick wall, a busy park-like scene),
 (soft studio, or hard sun casting the body's shadow on the wall beside it), motion blur
 (sub-frames averaged over half the frame interval), sensor noise and JPEG compression, and
 the lens: orthographic (a body far off), or perspective cameras a few metres away, the
-lateral one panning to keep the body mid-image (the ruled backdrop sliding past as it
+lateral one panning to keep the body mid-image (the ruled backdrop turning past as it
 turns). The body is the same skinned capsule body as the walk benchmark's
 (``walk_footage``), sized by the capture's parts.
 
@@ -160,6 +160,20 @@ def job_camera(R: np.ndarray, centre: np.ndarray) -> dict:
             "scale": PIXELS_PER_METRE, "center": [WIDTH / 2 - 0.5, HEIGHT / 2 - 0.5]}
 
 
+def turned_backdrop(back: np.ndarray, K: np.ndarray, R0: np.ndarray, R: np.ndarray
+                    ) -> np.ndarray:
+    """The backdrop ``back`` (as the camera with intrinsics K shows it turned by R0) seen by
+    the same camera turned to R about its centre: every still point moves by the homography
+    K R R0^T K^-1, whatever its depth. The backdrop is taken to repeat beyond its edges
+    (it is drawn periodic across), so a wide pan never runs out of wall."""
+    import cv2
+
+    h, w = back.shape[:2]
+    shift = np.array([[1.0, 0, w], [0, 1, h], [0, 0, 1]])  # the middle tile of a 3 x 3
+    H = K @ R @ R0.T @ np.linalg.inv(K) @ np.linalg.inv(shift)
+    return cv2.warpPerspective(np.tile(back, (3, 3, 1)), H, (w, h), flags=cv2.INTER_LINEAR)
+
+
 def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
     """Each view's job camera in ``look``: the clip's orthographic one, or a pinhole
     ``look.distance`` metres back along its line of sight showing the stage's centre as
@@ -228,6 +242,8 @@ def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
     meta = {"look": asdict(look), "frames": n, "version": 1}
     if look.distance is None:  # as the looks' stamps were before lenses were looks
         del meta["look"]["distance"], meta["look"]["pan"]
+    if look.pan:  # rendered again since its backdrop turns with the camera (it slid before)
+        meta["backdrop"] = "turned"
     ext = "jpg" if look.jpeg else "png"
     done = stamp.is_file() and json.loads(stamp.read_text()) == meta
     if done and all((out / v / f"{n - 1:04d}.{ext}").is_file() for v in VIEWS):
@@ -248,14 +264,12 @@ def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
         look_at = -Rs[0].T @ ts[0] + (look.distance or 0.0) * Rs[0][2]
         scene.camera = add_camera(bpy, v, Rs[0], look_at, WIDTH / PIXELS_PER_METRE,
                                   look.distance)
-        back = backdrop_image(look.backdrop, seed=17 + k)
+        still = back = backdrop_image(look.backdrop, seed=17 + k)
         (out / v).mkdir(parents=True, exist_ok=True)
         for f in range(n):
-            if len(Rs) > 1:  # a pan: the camera turns, the (periodic) backdrop slides past
+            if len(Rs) > 1:  # a pan: the camera turns, and the backdrop with it
                 place_camera(scene.camera, Rs[f], -Rs[f].T @ ts[f])
-                turn = np.arctan2(Rs[f][2] @ Rs[0][0], Rs[f][2] @ Rs[0][2])
-                back = np.roll(backdrop_image(look.backdrop, seed=17 + k),
-                               -int(round(PIXELS_PER_METRE * look.distance * np.tan(turn))), 1)
+                back = turned_backdrop(still, np.array(cams[v]["K"]), Rs[0], Rs[f])
             acc = np.zeros((HEIGHT, WIDTH, 3))
             for s in range(look.blur):
                 sub = (s / look.blur - 0.5) * 0.5 if look.blur > 1 else 0.0  # half a frame

@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "bench"))
 
 from captures import CMU_UNIT, Parts, normalized  # noqa: E402
-from suite_footage import view_rotations  # noqa: E402
+from suite_footage import turned_backdrop, view_rotations  # noqa: E402
 
 # a small body in Bandai Namco's layout: a still joint_Root, Hips carrying the motion, and
 # position channels on every joint that repeat its offset (centimetres)
@@ -140,3 +140,28 @@ def test_a_close_lens_shows_the_stage_centre_as_large_and_a_pan_keeps_the_root_c
                                                                     len(path), 0), atol=1e-9)
     turned = np.degrees(se3.angle_between_vectors(path[0].R[2], path[-1].R[2]))
     assert turned > 5  # the walker crosses the view: the camera follows
+
+
+def test_a_panning_cameras_backdrop_turns_with_it_as_any_still_scene_would():
+    """Rendered footage of a camera that turns on its tripod: each backdrop pixel goes where
+    the homography K R R0^T K^-1 takes it (a still point at any depth), the wall repeating
+    beyond its edges; not turned, the backdrop is as drawn."""
+    yy, xx = np.mgrid[:360, :480]
+    wave = 128 + 60 * np.sin(2 * np.pi * xx / 60) + 60 * np.cos(2 * np.pi * yy / 45)
+    back = np.repeat(wave[..., None], 3, axis=2).astype(np.float32)  # repeats across
+    K = np.array([[437.5, 0, 239.5], [0, 437.5, 179.5], [0, 0, 1]])
+    R0 = se3.exp_so3([0.0, 0.3, 0.0])
+    np.testing.assert_array_equal(turned_backdrop(back, K, R0, R0), back)
+    R = se3.exp_so3([0.0, 0.5, 0.0])
+    turned = turned_backdrop(back, K, R0, R)
+    H = K @ R @ R0.T @ np.linalg.inv(K)
+    seen = 0
+    for x, y in [(40.0, 30.0), (240.0, 180.0), (460.0, 330.0), (300.0, 20.0)]:
+        q = H @ [x, y, 1.0]
+        u, v = q[:2] / q[2]
+        if 0 <= u < 479 and 0 <= v < 359:  # where the turned camera still shows it
+            got = turned[int(round(v)), int(round(u))]
+            np.testing.assert_allclose(got, back[int(y), int(x)], atol=8)
+            seen += 1
+    assert seen >= 2
+    assert abs(turned[180, 240] - back[180, 240]).max() > 0  # it did turn
