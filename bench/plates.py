@@ -34,6 +34,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from evaluate import named_point
 from scipy.ndimage import median_filter
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -138,12 +139,8 @@ def body_length(spec: dict) -> float:
 def tips(sk: Skeleton, pose: BodyPose) -> dict[str, np.ndarray]:
     """Where the snout and the four feet (their bones' end sites) fall in the one view."""
     M = sk.joint_frames(pose.rotations, pose.root_position)
-    out = {}
-    for name in ("Head", *FEET["fore"], *FEET["hind"]):
-        j = sk.index(name)
-        tip = M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3]
-        out[name] = pose.views[0].project(tip[None])[0]
-    return out
+    return {name: pose.views[0].project(named_point(sk, M, f"{name}/end")[None])[0]
+            for name in ("Head", *FEET["fore"], *FEET["hind"])}
 
 
 def click_distances(clicked: dict, at: dict[str, np.ndarray]) -> list[float]:
@@ -174,15 +171,19 @@ class FrameScore:
     clicks_carried: float = float("nan")  # the mean for the first pose carried along
 
 
+def cut_frames(spec: dict) -> list[Path]:
+    """The frames of a clicks file that names frames already cut (``"frames"``, a folder of
+    the repository), in order."""
+    return sorted((ROOT / spec["frames"]).glob("*.png"))
+
+
 def run(name: str) -> list[FrameScore]:
     """Cut, pose, track and score the plate ``name``."""
     spec = json.loads((DATA / f"{name}.json").read_text())
     sk, first = planar_body(spec)
     with tempfile.TemporaryDirectory() as tmp:
-        if "plate" in spec:
-            _, paths = write_frames(ROOT / spec["plate"], tmp)
-        else:  # frames already cut
-            paths = sorted((ROOT / spec["frames"]).glob("*.png"))
+        paths = write_frames(ROOT / spec["plate"], tmp)[1] if "plate" in spec else cut_frames(
+            spec)
         with quiet_stderr():
             greys = [load_grey(p) for p in paths]
     tracker = Tracker(sk, [greys], INDEPENDENT)

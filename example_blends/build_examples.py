@@ -43,7 +43,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from addon_dev import load_addon  # noqa: E402
 from plates import DATA as PLATE_CLICKS  # noqa: E402
-from plates import planar_body  # noqa: E402
+from plates import cut_frames, planar_body  # noqa: E402
 from walk_footage import SPINE_JOINTS, render, tracking_scene  # noqa: E402
 
 WALK = dict(first=540, last=660, step=8)  # capture frames: one second at 15 fps
@@ -149,8 +149,7 @@ def build_plate(bpy, twist_addon, name: str, gait: bool) -> Path:
     if "plate" in spec:
         bpy.ops.twist.add_plate_view(filepath=str(ROOT / spec["plate"]), first_frame=1)
     else:  # frames already cut
-        first = sorted((ROOT / spec["frames"]).glob("*.png"))[0]
-        bpy.ops.twist.add_view(filepath=str(first), first_frame=1)
+        bpy.ops.twist.add_view(filepath=str(cut_frames(spec)[0]), first_frame=1)
     scene = bpy.context.scene
     arm = pose_on_plate(scene, twist_addon, spec, name)
     scene.render.fps = 15

@@ -19,9 +19,7 @@ def test_the_planar_body_stands_on_its_clicks():
     M = sk.joint_frames(pose.rotations, pose.root_position)
     view = pose.views[0]
     for name, xy in spec["clicks"].items():
-        joint, _, end = name.partition("/")
-        j = sk.index(joint)
-        point = M[j, :3, :3] @ sk.end_sites[j][0] + M[j, :3, 3] if end else M[j, :3, 3]
+        point = plates.named_point(sk, M, name)
         np.testing.assert_allclose(view.project(point[None])[0], xy, atol=1e-9)
 
 
