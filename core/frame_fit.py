@@ -124,7 +124,10 @@ class FrameFit:
         images: Sequence[Sequence],
         mode: str = INDEPENDENT,
         settings: TrackerSettings | None = None,
+        moving_views: Sequence[int] = (),
     ):
+        """``moving_views``: the views whose camera moves (their backdrop with it: no
+        silhouette there)."""
         if mode not in (CALIBRATED, INDEPENDENT):
             raise InputError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
         if not skeleton.blobs:
@@ -136,7 +139,8 @@ class FrameFit:
         self.scales = Scales.unscaled(self.seq.n_views, self.settings)
         # the key frame's points by (frame, view, level), kept while the key frame is
         self.key_sets: dict[tuple[int, int, int], PointSet] = {}
-        self._cue = sil.SilhouetteCue(self.seq)  # the backdrops, once the key frame is known
+        # the backdrops, once the key frame is known
+        self._cue = sil.SilhouetteCue(self.seq, moving_views)
         self.notes: list[str] = []  # what the user should know about the run
         self._use(skeleton)
 

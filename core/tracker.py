@@ -20,7 +20,6 @@ import numpy as np
 
 from . import image as imagelib
 from . import se3
-from . import silhouette as sil
 from .blas import one_blas_thread
 from .camera import Camera
 from .confidence import UNSEEN
@@ -74,9 +73,11 @@ class Tracker(FrameFit):
                  moving: Sequence[Sequence[Camera] | None] | None = None):
         """``moving``: per view, its camera on every frame where the camera moves (None for
         a view whose camera stands still); calibrated mode only."""
-        super().__init__(skeleton, images, mode, settings)
+        moving = list(moving) if moving is not None else [None] * len(images)
+        super().__init__(skeleton, images, mode, settings,
+                         [c for c, m in enumerate(moving) if m is not None])
         self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
-        self.moving = list(moving) if moving is not None else [None] * self.seq.n_views
+        self.moving = moving
         if any(m is not None for m in self.moving) and mode != CALIBRATED:
             raise InputError("cameras that move need the calibrated mode: the body's root is "
                              "tracked in the world, each camera is where it was filmed from")
@@ -84,9 +85,6 @@ class Tracker(FrameFit):
             if path is not None and len(path) < self.seq.n_frames():
                 raise InputError(f"view {c + 1}'s camera is given on {len(path)} frames, its "
                                  f"footage has {self.seq.n_frames()}")
-        # a moving camera's backdrop moves with it: no silhouette for that view
-        self._cue = sil.SilhouetteCue(self.seq, [c for c, m in enumerate(self.moving)
-                                                 if m is not None])
 
     def _filmed_from(self, pose: BodyPose, frame: int) -> BodyPose:
         """``pose`` seen through each view's camera as it stood on ``frame``."""
