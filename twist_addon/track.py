@@ -26,9 +26,10 @@ from .bridge import (
     tracking_mode,
     view_from_camera,
 )
+from .clip_lens import undistorted
 from .errors import INPUT_ERRORS
 from .properties import settings_from_properties
-from .views import footage_frames, unread_distortion
+from .views import footage_frames
 
 
 @dataclass
@@ -46,7 +47,7 @@ class TrackSession:
     corrections: dict[int, BodyPose] = field(default_factory=dict)  # by index in ``frames``
     tracked: list[FrameResult] = field(default_factory=list)
     scene_notes: list[str] = field(default_factory=list)  # what the scene holds that the
-    # tracker cannot use (``views.unread_distortion``)
+    # tracker cannot use, or reads its own way (``clip_lens.undistorted``)
 
     @property
     def notes(self) -> list[str]:
@@ -68,12 +69,14 @@ class TrackSession:
             frames = list(range(cur, scene.frame_start - 1, -1))
         if len(frames) < 2:
             raise BridgeError(f"nothing to track {tw.direction.lower()} from frame {cur}")
-        views, images, moving = [], [], []
+        views, images, moving, notes = [], [], [], []
         for v in tw.views:
             if v.camera is None:
                 raise BridgeError("a view has no camera; pick its camera or remove the view")
             views.append(view_from_camera(v.camera, scene))
-            images.append(footage_frames(v, frames))
+            footage, note = undistorted(v, footage_frames(v, frames))
+            images.append(footage)
+            notes += [note] if note else []
             moving.append(camera_path(v.camera, scene, frames))
         mode = tracking_mode(scene, views, moving)
         sk = tracked_skeleton(arm)
@@ -88,7 +91,6 @@ class TrackSession:
                 corrections[i] = BodyPose(*pose_from_armature(arm, sk), views)
         scene.frame_set(cur)
         R, root = pose_from_armature(arm, sk)
-        notes = [n for n in (unread_distortion(v) for v in tw.views) if n]
         return cls(arm, frames, tracker, BodyPose(R, root, views), user_keys, corrections,
                    scene_notes=notes)
 

@@ -46,30 +46,6 @@ def footage_frames(view_pg, frames: list[int]) -> list:
     return paths.select(indices)
 
 
-def unread_distortion(view_pg) -> str:
-    """'' unless the view's footage is a movie clip with lens distortion set in Blender's
-    Movie Clip editor (solved, or typed in): the tracker reads footage as filmed, so that
-    distortion is not undone; a note saying so and what to do."""
-    cam = view_pg.camera
-    for bg in cam.data.background_images if cam is not None else ():
-        clip = bg.clip if bg.source == "MOVIE_CLIP" else None
-        if clip is None:
-            continue
-        tc = clip.tracking.camera
-        coefficients = {
-            "POLYNOMIAL": (tc.k1, tc.k2, tc.k3),
-            "DIVISION": (tc.division_k1, tc.division_k2),
-            "NUKE": (tc.nuke_k1, tc.nuke_k2),
-            "BROWN": (tc.brown_k1, tc.brown_k2, tc.brown_k3, tc.brown_k4, tc.brown_p1,
-                      tc.brown_p2)}.get(tc.distortion_model, ())
-        if any(abs(k) > 1e-9 for k in coefficients):
-            return (f"the clip '{clip.name}' behind '{cam.name}' has lens distortion, which "
-                    "the tracker does not undo: it tracked the footage as if through an ideal "
-                    "lens (render the clip undistorted, or add the views from a calibration "
-                    "file, to track through the lens)")
-    return ""
-
-
 def add_footage_view(context, path: Path, first_frame: int) -> str:
     """Add a view of the footage ``path`` (a movie, or any image of a sequence: its folder's
     images of the same kind, in name order) from ``first_frame``: an orthographic camera

@@ -14,8 +14,8 @@ sys.path.insert(0, str(ROOT / "bench"))
 from walk_footage import JOINTS, render, tracking_scene  # noqa: E402
 
 from core import se3  # noqa: E402
-from core.bvh import read_bvh  # noqa: E402
 from support.layout import Recorder, draw_panel  # noqa: E402
+from support.legs import leg_errors  # noqa: E402
 
 VIEWS = ["lateral", "endon", "oblique60"]
 TRACKED = list(JOINTS)
@@ -49,24 +49,6 @@ def _scene(bpy, addon, folder: Path, frames: int = 6):
     return tracking_scene(bpy, folder, VIEWS, frames)
 
 
-def _leg_errors(scene, bridge, arm, folder: Path, frames) -> np.ndarray:
-    """(frames, 4): degrees between the keyed and the captured (folder/truth.bvh) thighs and
-    shanks on each scene frame of ``frames`` (scene frame f shows capture frame f - 1)."""
-    sk = bridge.skeleton_from_armature(arm)
-    truth = read_bvh(folder / "truth.bvh")
-    R_true, p_true = truth.poses()
-    out = []
-    for f in frames:
-        scene.frame_set(f)
-        got = sk.world_positions(*bridge.pose_from_armature(arm, sk))
-        want = dict(zip(truth.names, _bvh_world(truth, R_true[f - 1], p_true[f - 1])))
-        out.append([np.degrees(se3.angle_between_vectors(
-            got[sk.index(b)] - got[sk.index(a)], want[b] - want[a]))
-            for a, b in [("LeftHip", "LeftKnee"), ("RightHip", "RightKnee"),
-                         ("LeftKnee", "LeftAnkle"), ("RightKnee", "RightAnkle")]])
-    return np.array(out)
-
-
 def _channel_frames(arm):
     from bpy_extras import anim_utils
 
@@ -92,7 +74,7 @@ def test_track_keys_exactly_the_tracked_bones_and_frames(bpy_module, registered,
         assert keys[bone] == {(f, "GENERATED") for f in range(1, 7)}, bone
     assert keys["LeftCollar"] == {(3, "KEYFRAME")}
     # the tracked legs follow the capture
-    legs = _leg_errors(scene, registered.twist_addon.bridge, arm, footage, range(2, 7))
+    legs = leg_errors(scene, registered.twist_addon.bridge, arm, footage, range(2, 7))
     assert np.all(legs < 8.0), legs  # measured: at most 6.1 (knees as balls here)
 
 
@@ -118,7 +100,7 @@ def test_perspective_cameras_one_panning_track_through_the_operators(bpy_module,
     assert scene.twist.result.frames_tracked == 5
     # the panning camera's backdrop moves with it: its silhouette is left out, and said so
     assert "view 1: its camera moves" in scene.twist.result.notes
-    legs = _leg_errors(scene, bridge, arm, perspective_footage, range(2, 7))
+    legs = leg_errors(scene, bridge, arm, perspective_footage, range(2, 7))
     assert np.all(legs < 8.0), legs
 
 
@@ -305,12 +287,6 @@ def test_track_twice_and_clear_never_move_the_users_pose(bpy_module, registered,
         assert _pose_values(arm) == before, f
 
 
-def _bvh_world(bvh, R, p):
-    from core.skeleton import skeleton_from_bvh
-
-    return skeleton_from_bvh(bvh).world_positions(R, p)
-
-
 def test_clear_removes_only_what_tracking_wrote(bpy_module, registered, footage):
     bpy = bpy_module
     scene, arm = _scene(bpy, registered, footage)
@@ -424,21 +400,3 @@ def test_a_refine_round_that_fails_keeps_the_rounds_before_it(bpy_module, regist
                                atol=1e-6)
     keyed = _channel_frames(arm)
     assert all(set(range(2, 22)) <= {f for f, _ in keyed[b]} for b in TRACKED)
-
-
-def test_a_movie_clips_lens_distortion_is_named_as_not_undone(bpy_module, registered, footage):
-    """Footage shown through a movie clip whose lens distortion is set (Blender's camera
-    solver writes it there): the tracker reads frames as filmed, and Track says so."""
-    bpy = bpy_module
-    scene, _ = _scene(bpy, registered, footage, 3)
-    cam = scene.twist.views[0].camera
-    clip = bpy.data.movieclips.load(str(sorted((footage / VIEWS[0]).glob("*.png"))[0]))
-    bg = cam.data.background_images.new()
-    bg.source, bg.clip = "MOVIE_CLIP", clip
-    assert bpy.ops.twist.track() == {"FINISHED"}
-    assert "has lens distortion" not in scene.twist.result.notes
-    bpy.ops.twist.clear_track()
-    clip.tracking.camera.k1 = -0.08
-    assert bpy.ops.twist.track() == {"FINISHED"}
-    assert (f"the clip '{clip.name}' behind '{cam.name}' has lens distortion, which the "
-            "tracker does not undo") in scene.twist.result.notes
