@@ -163,8 +163,8 @@ class FrameFit:
     def _foregrounds(self, frame: int, level: int, key: BodyPose, key_frame: int,
                      est: BodyPose, kin: Kinematics) -> list | None:
         """Per view, the foreground of ``frame`` around the body at ``est`` on the view's
-        level for tracker level ``level`` (None when the term is off): (boolean crop, its
-        top-left level pixel, its ``NearestPixel``)."""
+        level for tracker level ``level`` (None when the term is off): (crop of its map, the
+        crop's top-left level pixel, its foreground's ``NearestPixel``)."""
         s = self.settings
         if s.silhouette <= 0:
             return None
@@ -186,7 +186,7 @@ class FrameFit:
             y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
             fg = sil.at_level(self._cue.foreground(c, frame), lv)[::g, ::g]
             crop = fg[y0:max(y1, y0), x0:max(x1, x0)]
-            out.append((crop, (x0, y0), sil.NearestPixel(crop)))
+            out.append((crop, (x0, y0), sil.NearestPixel(crop == sil.FOREGROUND)))
         return out
 
     def _start_cue(self, key: BodyPose, key_frame: int) -> None:
@@ -462,7 +462,8 @@ class FrameFit:
                 px -= (x0, y0)
                 inside = ((px >= 0) & (px < (crop.shape[1], crop.shape[0]))).all(axis=1)
                 on = np.full(len(px), np.nan)
-                on[inside] = crop[px[inside, 1], px[inside, 0]]
+                code = crop[px[inside, 1], px[inside, 0]]
+                on[inside] = np.where(code == sil.UNSURE, np.nan, code == sil.FOREGROUND)
             per_view.append(self._limbs.view_agreement(ps.blob, support, on))
         return self._limbs.checks(per_view)
 

@@ -30,12 +30,18 @@ class ImageError(InputError):
     """An image that cannot be read; the message names the file."""
 
 
-def load_grey(path: str | Path) -> np.ndarray:
-    """Read an image file as float32 grey in [0, 1]."""
+def load_image(path: str | Path) -> np.ndarray:
+    """Read an image file as it is stored: (H, W) or (H, W, C) in BGR(A) order, of its own
+    type (uint8, uint16 or float)."""
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ImageError(f"{path}: cannot read this image (missing, or not an image format)")
-    return to_grey(img)
+    return img
+
+
+def load_grey(path: str | Path) -> np.ndarray:
+    """Read an image file as float32 grey in [0, 1]."""
+    return to_grey(load_image(path))
 
 
 def check_footage(paths, where: str) -> None:
@@ -77,16 +83,40 @@ class quiet_stderr:
         os.close(self._saved)
 
 
-def to_grey(img: np.ndarray) -> np.ndarray:
-    """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 grey in [0, 1]."""
+def to_float(img: np.ndarray) -> np.ndarray:
+    """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 in [0, 1], grey (H, W)
+    or BGR (H, W, 3) (alpha dropped)."""
     if img.dtype == np.uint8:
         img = img.astype(np.float32) / 255
     elif img.dtype == np.uint16:
         img = img.astype(np.float32) / 65535
     else:
         img = img.astype(np.float32)
+    if img.ndim == 3 and img.shape[2] == 1:
+        img = img[..., 0]
+    return np.ascontiguousarray(img[..., :3] if img.ndim == 3 else img)
+
+
+def to_grey(img: np.ndarray) -> np.ndarray:
+    """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 grey in [0, 1]."""
+    img = to_float(img)
     if img.ndim == 3:
-        img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2GRAY)
+        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    return np.ascontiguousarray(img)
+
+
+def to_colour(img: np.ndarray) -> np.ndarray | None:
+    """uint8/uint16/float image (H, W[, C]) in BGR(A) order to uint8 BGR (H, W, 3); None for
+    a grey image (one channel, or three equal ones: a grey picture stored as colour)."""
+    if img.ndim != 3 or img.shape[2] < 3:
+        return None
+    img = img[..., :3]
+    if img.dtype == np.uint16:
+        img = (img >> 8).astype(np.uint8)
+    elif img.dtype != np.uint8:
+        img = np.clip(img * 255 + 0.5, 0, 255).astype(np.uint8)
+    if np.array_equal(img[..., 0], img[..., 1]) and np.array_equal(img[..., 1], img[..., 2]):
+        return None
     return np.ascontiguousarray(img)
 
 

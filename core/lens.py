@@ -20,9 +20,9 @@ from . import image as imagelib
 
 class Undistorted(Sequence):
     """A view's frames (image paths, arrays or a movie's frames) read undistorted: item i is
-    frame i as the ideal pinhole K sees it, a grey float32 image in [0, 1], on the frames'
-    own pixel grid or on one ``size`` = (width, height) (the calibration's, where the footage
-    was cropped)."""
+    frame i as the ideal pinhole K sees it, a float32 image in [0, 1] with the frame's own
+    channels (grey (H, W), or BGR (H, W, 3)), on the frames' own pixel grid or on one
+    ``size`` = (width, height) (the calibration's, where the footage was cropped)."""
 
     def __init__(self, source: Sequence, K: np.ndarray, dist: np.ndarray,
                  size: tuple[int, int] | None = None):
@@ -39,8 +39,8 @@ class Undistorted(Sequence):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
         src = self.source[i]
-        return self.remap(imagelib.to_grey(src) if isinstance(src, np.ndarray)
-                          else imagelib.load_grey(src))
+        img = src if isinstance(src, np.ndarray) else imagelib.load_image(src)
+        return self.remap(imagelib.to_float(img))
 
     def remap(self, img: np.ndarray) -> np.ndarray:
         """An image (grey or colour) of the footage as filmed, undistorted."""

@@ -33,6 +33,7 @@ from .confidence import Limbs
 from .linearize import Kinematics
 from .pose import BodyPose
 from .raycast import BlobStack, blob_frames
+from .silhouette import BACKDROP, FOREGROUND, UNSURE
 from .skeleton import BALL, HINGE, Skeleton
 
 SWING = (np.arange(-60, 61, 15), np.arange(-10, 11, 5))  # coarse grid, then around the best
@@ -149,11 +150,12 @@ class LimbSearch:
     def run(self, pose: BodyPose, views: Sequence[Camera], fgs: Sequence[np.ndarray | None]
             ) -> tuple[BodyPose, list[str]]:
         """The pose with each limb turned to its best place, and the joints that turned.
-        ``views`` and ``fgs`` (boolean masks; None for a view without one) share one level; a
-        view where under ``MIN_FOREGROUND`` of the body's outline is foreground is left out.
-        With one view left, only hinges whose axis points along that view turn (a limb seen
-        side-on, an animal's): any other turn moves the limb in depth too, and one outline
-        cannot tell a limb turned toward the camera from a shorter one."""
+        ``views`` and ``fgs`` (foreground maps, ``core.silhouette``'s; None for a view
+        without one) share one level; a view where under ``MIN_FOREGROUND`` of the body's
+        outline is foreground (of what is not unsure) is left out. With one view left, only
+        hinges whose axis points along that view turn (a limb seen side-on, an animal's):
+        any other turn moves the limb in depth too, and one outline cannot tell a limb
+        turned toward the camera from a shorter one."""
         pose = pose.copy()
         kin = Kinematics(self.sk, pose)
         A, C = blob_frames(self.blobs, kin.segments)
@@ -186,17 +188,20 @@ class LimbSearch:
         when the body as a whole is far off."""
         body = np.zeros(fg.shape, bool)
         paint(body, view, A, C, (0, 0, fg.shape[1], fg.shape[0]))
-        return float(fg[body].mean()) if body.any() else 0.0
+        known = fg[body][fg[body] != UNSURE]
+        return float(np.mean(known == FOREGROUND)) if len(known) else 0.0
 
     @staticmethod
     def _gain_sums(view: Camera, fg: np.ndarray, A, C, box) -> np.ndarray:
         """Row prefix sums (rows, cols + 1) over ``box`` of what covering each pixel costs:
-        nothing where the ellipsoids A, C (the rest of the body) cover it, else 1 on the
-        background and -``UNCOVERED_GAIN`` on the foreground."""
+        nothing where the ellipsoids A, C (the rest of the body) cover it or the foreground
+        map is unsure, else 1 on the background and -``UNCOVERED_GAIN`` on the foreground."""
         x0, y0, x1, y1 = box
         others = np.zeros((y1 - y0, x1 - x0), bool)
         paint(others, view, A, C, box)
-        gain = np.where(others, 0.0, np.where(fg[y0:y1, x0:x1], -UNCOVERED_GAIN, 1.0))
+        code = fg[y0:y1, x0:x1]
+        gain = np.where(others, 0.0, np.select([code == FOREGROUND, code == BACKDROP],
+                                               [-UNCOVERED_GAIN, 1.0], 0.0))
         S = np.zeros((gain.shape[0], gain.shape[1] + 1))
         np.cumsum(gain, axis=1, out=S[:, 1:])
         return S

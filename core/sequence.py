@@ -19,8 +19,9 @@ from . import image as imagelib
 
 class ImageSequence:
     """``images[view][frame]`` is a path or an array; grey images are float32 (H, W) in
-    [0, 1], pyramids finest level first (``core.image.pyramid``), ``levels[view]`` levels
-    each (``levels`` given as one number for every view)."""
+    [0, 1], colour ones uint8 BGR (H, W, 3) (None for grey footage), pyramids finest level
+    first (``core.image.pyramid``), ``levels[view]`` levels each (``levels`` given as one
+    number for every view)."""
 
     def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0):
         self.images = images
@@ -28,7 +29,8 @@ class ImageSequence:
         self.highpass = highpass
         self._pyramids: dict[tuple[int, int], list[imagelib.Level]] = {}  # (view, frame)
         self._grey: dict[tuple[int, int], np.ndarray] = {}
-        self._ahead: dict[int, Future] = {}  # frame -> per view (grey, pyramid)
+        self._colour: dict[tuple[int, int], np.ndarray | None] = {}
+        self._ahead: dict[int, Future] = {}  # frame -> per view (grey, colour, pyramid)
         self._reader = ThreadPoolExecutor(max_workers=1, thread_name_prefix="twist-read")
 
     @property
@@ -52,14 +54,20 @@ class ImageSequence:
         if key not in self._grey:
             self._collect(frame)
         if key not in self._grey:
-            self._grey[key] = self._read(view, frame)
+            self._grey[key], self._colour[key] = self._read(view, frame)
         return self._grey[key]
 
-    def peek_grey(self, view: int, frame: int) -> np.ndarray:
-        """``grey``, without keeping the image for later (a glance at a frame the run may
-        not reach for a long time)."""
+    def colour(self, view: int, frame: int) -> np.ndarray | None:
+        """The full-resolution colour image, None for grey footage."""
+        self.grey(view, frame)
+        return self._colour[view, frame]
+
+    def peek(self, view: int, frame: int) -> tuple[np.ndarray, np.ndarray | None]:
+        """``grey`` and ``colour``, without keeping them for later (a glance at a frame the
+        run may not reach for a long time)."""
         key = (view, frame)
-        return self._grey[key] if key in self._grey else self._read(view, frame)
+        return (self._grey[key], self._colour[key]) if key in self._grey else \
+            self._read(view, frame)
 
     def set_levels(self, levels: Sequence[int]) -> None:
         """Build each view's pyramids with ``levels[view]`` levels from now on; those built
@@ -77,12 +85,12 @@ class ImageSequence:
                                        for c in range(self.n_views)):
             return
         self._ahead[frame] = self._reader.submit(
-            lambda: [(g, self._build(c, g)) for c, g in
+            lambda: [(g, rgb, self._build(c, g)) for c, (g, rgb) in
                      ((c, self._read(c, frame)) for c in range(self.n_views))])
 
     def keep_only(self, keys: set[tuple[int, int]]) -> None:
         """Forget every (view, frame) not in ``keys``; frames being read ahead stay."""
-        for cache in (self._pyramids, self._grey):
+        for cache in (self._pyramids, self._grey, self._colour):
             for k in list(cache):
                 if k not in keys:
                     del cache[k]
@@ -91,13 +99,15 @@ class ImageSequence:
         """Take a frame read ahead into the caches (waiting for it if need be)."""
         if frame not in self._ahead:
             return
-        for c, (grey, pyr) in enumerate(self._ahead.pop(frame).result()):
-            self._grey.setdefault((c, frame), grey)
+        for c, (grey, rgb, pyr) in enumerate(self._ahead.pop(frame).result()):
+            if (c, frame) not in self._grey:
+                self._grey[c, frame], self._colour[c, frame] = grey, rgb
             self._pyramids.setdefault((c, frame), pyr)
 
-    def _read(self, view: int, frame: int) -> np.ndarray:
+    def _read(self, view: int, frame: int) -> tuple[np.ndarray, np.ndarray | None]:
         src = self.images[view][frame]
-        return imagelib.to_grey(src) if isinstance(src, np.ndarray) else imagelib.load_grey(src)
+        img = src if isinstance(src, np.ndarray) else imagelib.load_image(src)
+        return imagelib.to_grey(img), imagelib.to_colour(img)
 
     def _build(self, view: int, grey: np.ndarray) -> list[imagelib.Level]:
         return imagelib.pyramid(grey, self.levels[view], highpass=self.highpass)

@@ -3,11 +3,16 @@ long, where brightness constancy only reaches a blob's width.
 
 Each view's backdrop is the key frame with the body taken out (see ``Backdrop``); a pixel
 is foreground where it differs from the backdrop by more than a threshold set from the
-image's own noise (the cameras must stand still). Two chamfer terms compare the
-blobs' projection (a label map) with the foreground, each in both directions:
-foreground pixels no blob covers pull the nearest covered pixel toward them, and covered
-pixels off the foreground are pulled to the nearest foreground pixel. Distances are in
-level pixels, capped so that clutter far from the body cannot pull.
+image's own noise (the cameras must stand still). In colour footage, a changed pixel whose
+colour is the backdrop's, darkened or lightened as a shadow does, is unsure: the body's
+own cast shadow, or one the key frame held, on a backdrop whose colour shows it (on a
+colourless one a shadow cannot be told from a grey body, and it stays foreground). Two
+chamfer terms compare the blobs' projection (a label map) with the foreground, each in both
+directions: foreground pixels no blob covers pull the nearest covered pixel toward them,
+and covered pixels off the foreground are pulled to the nearest foreground pixel; unsure
+pixels do neither. Distances are in level pixels, capped so that clutter far from the body
+cannot pull. A foreground map holds one code per pixel: ``BACKDROP``, ``FOREGROUND`` or
+``UNSURE`` (a boolean mask is a map with no unsure pixels).
 """
 
 from __future__ import annotations
@@ -26,6 +31,11 @@ INPAINT_RADIUS = 6  # pixels around a painted-out pixel its value is drawn from 
 # grows with its square: at the margin of a body 800 pixels tall, 24, it took 2 s a view)
 STILL_AREA_RATIO = 4.0  # a backdrop holds while frames' foreground stays under this x body
 BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop behind the body
+BACKDROP, FOREGROUND, UNSURE = 0, 1, 2  # a foreground map's codes
+SHADOW_DEPTH = 0.3  # the darkest a shadow leaves its backdrop (sunlight's keep the sky's light)
+NOISE_STRIDE = 4  # rows and columns between the pixels the colour noise is measured on
+SHADOW_CHROMA = 6.0  # colour off the backdrop's, in its median over pixels that stay the same,
+# still called the backdrop's own
 
 
 class Backdrop:
@@ -39,51 +49,121 @@ class Backdrop:
     footage differ from it over far more than the body's area (a moving camera, changing
     light)."""
 
-    def __init__(self, grey: np.ndarray, body: np.ndarray, frames: Iterable[np.ndarray] = (),
-                 margin: int = BODY_MARGIN):
+    def __init__(self, grey: np.ndarray, body: np.ndarray,
+                 frames: Iterable[tuple[np.ndarray, np.ndarray | None]] = (),
+                 margin: int = BODY_MARGIN, colour: np.ndarray | None = None):
+        """``grey`` float (H, W) and ``colour`` uint8 BGR (H, W, 3) or None: the key frame;
+        ``body``: its body's pixels; ``frames``: (grey, colour) of other frames."""
         grey = np.asarray(grey, np.float32)
         self.margin = margin
         self.unseen = self._widen(body)  # pixels whose backdrop is only painted in
         img8 = np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8)
-        self.image = cv2.inpaint(img8, self.unseen.astype(np.uint8), INPAINT_RADIUS,
+        holes = self.unseen.astype(np.uint8)
+        self.image = cv2.inpaint(img8, holes, INPAINT_RADIUS,
                                  cv2.INPAINT_TELEA).astype(np.float32) / 255
+        self.colour = None if colour is None else cv2.inpaint(colour, holes, INPAINT_RADIUS,
+                                                              cv2.INPAINT_TELEA)
         noise = np.abs(grey - cv2.medianBlur(grey, 3))[~self.unseen]
         self.threshold = max(MIN_CONTRAST, 6 * 1.4826 * float(np.median(noise)))
-        area = [self.foreground(np.asarray(f, np.float32)).sum() for f in frames]
+        frames = [(np.asarray(f, np.float32), c) for f, c in frames]
+        self.chroma_noise = self._chroma_noise(frames)
+        area = [np.count_nonzero(self.foreground(f, c) == FOREGROUND) for f, c in frames]
         self.still = not area or float(np.median(area)) <= STILL_AREA_RATIO * max(
             int(body.sum()), 1)
+
+    def _chroma_noise(self, frames) -> float | None:
+        """The median colour distortion (``_chroma``) of frames against the backdrop over
+        the seen pixels they leave the same (every ``NOISE_STRIDE``-th row and column: a
+        median needs no more); None without colour frames to measure it."""
+        if self.colour is None or not any(c is not None and c.shape == self.colour.shape
+                                          for _, c in frames):
+            return None
+        found = []
+        for grey, c in frames:
+            if c is None or c.shape != self.colour.shape:
+                continue
+            k = NOISE_STRIDE
+            same = (np.abs(grey[::k, ::k] - self.image[::k, ::k]) <= self.threshold) \
+                & ~self.unseen[::k, ::k]
+            found.append(_chroma(c[::k, ::k][same], self.colour[::k, ::k][same])[0])
+        found = np.concatenate(found)
+        return float(np.median(found)) if len(found) else None
 
     def _widen(self, body: np.ndarray) -> np.ndarray:
         k = np.ones((2 * self.margin + 1,) * 2, np.uint8)
         return cv2.dilate(body.astype(np.uint8), k) > 0
 
-    def learn(self, grey: np.ndarray, body: np.ndarray) -> None:
+    def learn(self, grey: np.ndarray, body: np.ndarray, colour: np.ndarray | None = None
+              ) -> None:
         """Take the backdrop from a tracked frame wherever it is still unseen and that frame's
         body (its blobs' pixels) is not."""
         if grey.shape != self.image.shape:
             return
         seen = self.unseen & ~self._widen(body)
         self.image[seen] = grey[seen]
+        if self.colour is not None and colour is not None:
+            self.colour[seen] = colour[seen]
         self.unseen &= ~seen
 
-    def foreground(self, grey: np.ndarray) -> np.ndarray:
-        """Foreground of a full-resolution grey frame, as 0/1 floats (H, W): pixels off the
-        backdrop, specks removed. Holes are kept: the gap between an arm and the trunk is
-        one. A frame a few pixels larger or smaller than the backdrop is compared where they
-        overlap (top-left corners together); the rest is backdrop."""
+    def foreground(self, grey: np.ndarray, colour: np.ndarray | None = None) -> np.ndarray:
+        """Foreground map (H, W) of a full-resolution frame (grey, and colour or None):
+        pixels off the backdrop, specks removed, are ``FOREGROUND``, or ``UNSURE`` where
+        their colour is the backdrop's shaded (``shaded``). Holes are kept: the gap between
+        an arm and the trunk is one. A frame a few pixels larger or smaller than the
+        backdrop is compared where they overlap (top-left corners together); the rest is
+        backdrop."""
         h, w = (min(a, b) for a, b in zip(grey.shape, self.image.shape))
-        fg = np.zeros(grey.shape, np.float32)
+        fg = np.zeros(grey.shape, np.uint8)
         fg[:h, :w] = np.abs(grey[:h, :w] - self.image[:h, :w]) > self.threshold
-        return cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+        fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+        if self.chroma_noise is not None and colour is not None and \
+                colour.shape == self.colour.shape:
+            ys, xs = np.nonzero(fg)
+            shadow = self.shaded(colour[ys, xs], self.colour[ys, xs])
+            unsure = np.zeros(fg.shape, np.uint8)
+            unsure[ys[shadow], xs[shadow]] = 1
+            # specks too: a shadow is a patch, a lone pixel the backdrop's colour is noise
+            unsure = cv2.morphologyEx(unsure, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+            fg[unsure > 0] = UNSURE
+        return fg
+
+    def shaded(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
+        """Which pixels' colours ``seen`` (N, 3) are their ``backdrop`` colours (N, 3)
+        scaled by a shadow falling or lifting (brightness between ``SHADOW_DEPTH`` and its
+        inverse), within ``SHADOW_CHROMA`` times the footage's colour noise, where that
+        backdrop's colour is told from grey at that brightness (else a grey body would pass
+        for its shadow)."""
+        off, scale = _chroma(seen, backdrop)
+        grey = np.repeat(seen.astype(np.float32).mean(1, keepdims=True), 3, 1)
+        tell = SHADOW_CHROMA * self.chroma_noise
+        return ((off <= tell) & (scale >= SHADOW_DEPTH) & (scale <= 1 / SHADOW_DEPTH)
+                & (_chroma(grey, backdrop)[0] > tell))
+
+
+def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How far colours ``seen`` (N, 3) are from their ``backdrop`` colours (N, 3) scaled to
+    fit them best (a length in 0-255 units), and that scale: a pixel under a shadow is its
+    backdrop scaled, with no colour off it."""
+    f, b = seen.astype(np.float32), backdrop.astype(np.float32)
+    scale = np.sum(f * b, 1) / np.maximum(np.sum(b * b, 1), 1.0)
+    return np.linalg.norm(f - scale[:, None] * b, axis=1), scale
 
 
 def at_level(fg: np.ndarray, level: int) -> np.ndarray:
-    """A full-resolution 0/1 foreground as a boolean mask on pyramid level ``level``, made
-    the way the image pyramid is (``cv2.pyrDown``: level pixel i centred on pixel 2i below),
-    so that the mask and the level's label maps line up."""
-    for _ in range(level):
-        fg = cv2.pyrDown(fg)
-    return fg > 0.5
+    """A full-resolution foreground map as one on pyramid level ``level``, made the way the
+    image pyramid is (``cv2.pyrDown``: level pixel i centred on pixel 2i below), so that the
+    map and the level's label maps line up: a level pixel is foreground where most of what
+    it covers is, else unsure where most is unsure."""
+    def down(mask):
+        mask = mask.astype(np.float32)
+        for _ in range(level):
+            mask = cv2.pyrDown(mask)
+        return mask > 0.5
+
+    out = down(fg == FOREGROUND).astype(np.uint8)
+    if np.any(fg == UNSURE):
+        out[down(fg == UNSURE) & (out == BACKDROP)] = UNSURE
+    return out
 
 
 @dataclass
@@ -120,14 +200,17 @@ class NearestPixel:
 def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLACK,
              uncovered_weight: float = UNCOVERED_WEIGHT,
              nearest_fg: NearestPixel | None = None) -> Mismatch:
-    """Both chamfer terms between a label map (H, W; -1 where no blob) and a foreground: a
+    """Both chamfer terms between a label map (H, W; -1 where no blob) and a foreground map
+    (unsure pixels take no part): a
     pixel ``d`` from its match costs (min(d, cap) - slack)^2 if positive, and wants to move
     d - slack toward it (the slack forgives outline noise and the holes a body shows where
     it happens to match the backdrop). Uncovered foreground weighs ``uncovered_weight``:
     it also comes from what the blobs do not model, and pulled the shanks toward the feet.
-    ``nearest_fg``: the foreground's ``NearestPixel`` (its mask is ``fg``), to share
-    between label maps."""
+    ``nearest_fg``: the foreground's ``NearestPixel`` (its mask is ``fg == FOREGROUND``), to
+    share between label maps."""
     covered = labels >= 0
+    background = fg == BACKDROP
+    fg = fg == FOREGROUND
     cost = 0.0
     # uncovered foreground pulls its nearest covered pixel; covered background is pulled to
     # its nearest foreground pixel
@@ -135,7 +218,7 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
     nearest_fg = NearestPixel(fg) if nearest_fg is None else nearest_fg
     for src, nearest, move_near, w in ((fg & ~covered, NearestPixel(covered), True,
                                         uncovered_weight),
-                                       (covered & ~fg, nearest_fg, False, 1.0)):
+                                       (covered & background, nearest_fg, False, 1.0)):
         if not src.any() or not nearest.mask.any():
             continue
         ys, xs = np.nonzero(src)
@@ -190,7 +273,8 @@ class SilhouetteCue:
                 self.backdrops.append(None)
                 continue
             backdrop = Backdrop(self.seq.grey(c, key_frame), body, (
-                self.seq.peek_grey(c, f) for f in sorted(set(others) - {key_frame})), margin)
+                self.seq.peek(c, f) for f in sorted(set(others) - {key_frame})), margin,
+                self.seq.colour(c, key_frame))
             if not backdrop.still:
                 notes.append(f"view {c + 1}: the footage around the body changes from frame "
                              "to frame far more than a body's outline (a moving camera or "
@@ -204,12 +288,12 @@ class SilhouetteCue:
         return self.backdrops is not None and self.backdrops[view] is not None
 
     def foreground(self, view: int, frame: int) -> np.ndarray:
-        """Full-resolution 0/1 foreground of ``frame`` in ``view`` (one that ``has``); only
+        """Full-resolution foreground map of ``frame`` in ``view`` (one that ``has``); only
         one frame's are kept."""
         if (view, frame) not in self._foregrounds:
             self._foregrounds = {k: v for k, v in self._foregrounds.items() if k[1] == frame}
             self._foregrounds[view, frame] = self.backdrops[view].foreground(
-                self.seq.grey(view, frame))
+                self.seq.grey(view, frame), self.seq.colour(view, frame))
         return self._foregrounds[view, frame]
 
     def unseen(self, view: int) -> bool:
@@ -218,4 +302,5 @@ class SilhouetteCue:
 
     def learn(self, view: int, frame: int, body: np.ndarray) -> None:
         """Let ``view``'s backdrop see what ``frame`` shows away from the body there."""
-        self.backdrops[view].learn(self.seq.grey(view, frame), body)
+        self.backdrops[view].learn(self.seq.grey(view, frame), body,
+                                   self.seq.colour(view, frame))

@@ -6,7 +6,8 @@ import numpy as np
 from core import raycast, se3
 from core.linearize import Kinematics
 from core.pose import INDEPENDENT, BodyPose, apply_update
-from core.search import LimbSearch, outlines, paint, span_sums, spans
+from core.search import UNCOVERED_GAIN, LimbSearch, outlines, paint, span_sums, spans
+from core.silhouette import BACKDROP, FOREGROUND, UNSURE
 from core.skeleton import human_template
 from support.synthetic import side_view
 
@@ -134,3 +135,25 @@ def test_a_limb_is_not_turned_past_its_limits():
     # 70 degrees out, the shank at its limit still misses its outline by 20: not worth a
     # turn of 50 degrees from its prediction, which must pay for its size
     assert search(70) == 0.0
+
+
+def test_unsure_pixels_weigh_nothing_in_the_search():
+    """Covering an unsure pixel (a shadow, to colour) neither costs nor pays, and a view
+    whose body lies on unsure pixels is judged by the rest of its outline."""
+    sk = human_template()
+    pose = _rest(sk)
+    view = pose.views[0]
+    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, pose).segments)
+    body = _foreground(sk, pose, view)
+    fg = np.where(body, FOREGROUND, BACKDROP).astype(np.uint8)
+    fg[:, :120] = np.where(body[:, :120], UNSURE, fg[:, :120])  # the body's left, shaded
+    fg[:40] = UNSURE  # a strip of shade, no body
+    box = (0, 0, BODY[1], BODY[0])
+    none = np.zeros(0, int)
+    S = LimbSearch._gain_sums(view, fg, A[none], C[none], box)
+    want = np.select([fg == FOREGROUND, fg == BACKDROP], [-UNCOVERED_GAIN, 1.0], 0.0)
+    np.testing.assert_allclose(S[:, -1], want.sum(1))
+    assert S[:40, -1].max() == 0.0
+    assert LimbSearch._foreground_share(view, fg, A, C) == 1.0
+    fg[body & (fg == FOREGROUND)] = BACKDROP
+    assert LimbSearch._foreground_share(view, fg, A, C) == 0.0

@@ -27,6 +27,8 @@ def test_a_frame_read_ahead_is_the_frame_read_when_asked(footage):
     ahead.read_ahead(1)
     for c in range(2):
         np.testing.assert_array_equal(ahead.grey(c, 1), plain.grey(c, 1))
+        np.testing.assert_array_equal(ahead.colour(c, 1), cv2.imread(str(footage[c][1])))
+        np.testing.assert_array_equal(plain.peek(c, 1)[1], ahead.colour(c, 1))
         for a, b in zip(ahead.pyramid(c, 1), plain.pyramid(c, 1), strict=True):
             np.testing.assert_array_equal(a.stack, b.stack)
             assert a.scale == b.scale
@@ -70,3 +72,13 @@ def test_a_movie_read_from_two_threads_gives_each_its_own_frame(footage, tmp_pat
         got = list(pool.map(lambda i: (i, video[i]), order))
     for i, frame in got:
         np.testing.assert_array_equal(frame, once[i])
+
+
+def test_grey_footage_has_no_colour(tmp_path):
+    """Grey files, and grey pictures stored as colour (three equal channels), have none."""
+    img = np.random.default_rng(4).integers(0, 256, (20, 30), dtype=np.uint8)
+    cv2.imwrite(str(tmp_path / "grey.png"), img)
+    cv2.imwrite(str(tmp_path / "as_colour.png"), cv2.merge([img] * 3))
+    seq = ImageSequence([[tmp_path / "grey.png", tmp_path / "as_colour.png"]], 1)
+    assert seq.colour(0, 0) is None and seq.colour(0, 1) is None
+    np.testing.assert_allclose(seq.grey(0, 0), seq.grey(0, 1), atol=1e-6)

@@ -1,5 +1,6 @@
 """The silhouette cue: chamfer mismatches against brute force, a backdrop learned behind a
-body that hardly moves, a moving camera noticed, and a limb caught beyond brightness's reach."""
+body that hardly moves, shadows told from the body by colour, a moving camera noticed, and a
+limb caught beyond brightness's reach."""
 
 import cv2
 import numpy as np
@@ -7,7 +8,15 @@ import numpy as np
 from core import se3
 from core.pose import INDEPENDENT, BodyPose, apply_update
 from core.settings import TrackerSettings
-from core.silhouette import Backdrop, NearestPixel, at_level, mismatch
+from core.silhouette import (
+    BACKDROP,
+    FOREGROUND,
+    UNSURE,
+    Backdrop,
+    NearestPixel,
+    at_level,
+    mismatch,
+)
 from core.skeleton import planar_chain_template
 from core.tracker import Tracker, track
 from support.synthetic import render, side_view
@@ -74,7 +83,7 @@ def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
         return img + rng.normal(0, 0.005, shape).astype(np.float32)
 
     home = (80, 60)
-    bd = Backdrop(frame(home), _disc(shape, home, 18), [frame(home)] * 5)
+    bd = Backdrop(frame(home), _disc(shape, home, 18), [(frame(home), None)] * 5)
     assert bd.still
     under = _disc(shape, home, 18)
     assert np.mean(np.abs(bd.image - backdrop)[under] < 0.03) < 0.9  # painted: lines lost
@@ -89,12 +98,96 @@ def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
                                   cv2.pyrDown(fg.astype(np.float32)).shape)
 
 
+def _sunlit(wall_colour, shape=(120, 160), seed=2):
+    """A textured wall of one colour (BGR, 0-1) with a grey body on it, frame by frame: the
+    body (a disc) and its cast shadow (the wall at 0.45 of its light, a disc beside it)
+    move right by 30 pixels a frame. Returns frame k as (grey, colour), the body's and the
+    shadow's pixels."""
+    rng = np.random.default_rng(seed)
+    texture = cv2.GaussianBlur(rng.uniform(0.6, 1.0, shape).astype(np.float32), (0, 0), 1.5)
+    wall = texture[..., None] * np.float32(wall_colour)
+
+    def frame(k):
+        body, shadow = _disc(shape, (40 + 30 * k, 60), 16), _disc(shape, (52 + 30 * k, 52), 18)
+        shadow &= ~body
+        img = wall.copy()
+        img[shadow] *= 0.45
+        img[body] = 0.2
+        img = np.clip(img + rng.normal(0, 0.005, img.shape), 0, 1)
+        rgb = (img * 255 + 0.5).astype(np.uint8)
+        return (cv2.cvtColor(img.astype(np.float32), cv2.COLOR_BGR2GRAY), rgb), body, shadow
+
+    return frame
+
+
+def test_a_cast_shadow_on_a_coloured_wall_is_unsure_and_the_body_foreground():
+    """On a tan wall a shadow keeps the wall's colour, darker: its pixels are unsure, the
+    key frame's shadow lit again later is too, and the grey body stays foreground; the
+    backdrop holds (the shadows do not count against it). Grey footage of the same cannot
+    tell them apart: the shadow is foreground."""
+    frame = _sunlit((0.4, 0.65, 0.9))
+    (g0, c0), body0, _ = frame(0)
+    bd = Backdrop(g0, body0, [frame(k)[0] for k in (1, 2, 3)], colour=c0)
+    assert bd.still and bd.chroma_noise is not None
+    (g, c), body, shadow = frame(3)
+    fg = bd.foreground(g, c)
+    assert np.mean(fg[shadow] == UNSURE) > 0.9
+    assert np.mean(fg[body] == FOREGROUND) > 0.97
+    _, _, old_shadow = frame(0)
+    lit_again = old_shadow & ~body0 & ~body & ~shadow
+    assert np.mean(fg[lit_again] != FOREGROUND) > 0.9
+    grey_only = Backdrop(g0, body0, [(f[0], None) for f, _, _ in map(frame, (1, 2, 3))])
+    assert np.mean(grey_only.foreground(g)[shadow] == FOREGROUND) > 0.9
+
+
+def test_a_shadow_on_a_colourless_wall_stays_foreground():
+    """On a grey wall a grey body is the wall scaled, as a shadow is: colour cannot tell
+    them apart, and neither is taken for a shadow."""
+    frame = _sunlit((0.75, 0.75, 0.75))
+    (g0, c0), body0, _ = frame(0)
+    bd = Backdrop(g0, body0, [frame(k)[0] for k in (1, 2, 3)], colour=c0)
+    (g, c), body, shadow = frame(3)
+    fg = bd.foreground(g, c)
+    assert np.mean(fg[shadow | body] == FOREGROUND) > 0.95
+
+
+def test_unsure_pixels_neither_pull_nor_are_pulled():
+    shape = (60, 80)
+    labels = np.full(shape, -1)
+    labels[_disc(shape, (30, 30), 10)] = 0
+    fg = np.full(shape, BACKDROP, np.uint8)
+    fg[_disc(shape, (30, 30), 10)] = FOREGROUND
+    beside = _disc(shape, (52, 30), 9)
+    for code, pairs in ((UNSURE, 0), (FOREGROUND, 1), (BACKDROP, 0)):
+        shaded = fg.copy()
+        shaded[beside] = code  # a shadow beside the body: unsure pulls nothing
+        assert (len(mismatch(labels, shaded, 15.0).model) > 0) == bool(pairs)
+    covered = labels.copy()
+    covered[beside] = 0  # the blobs over the shadow: unsure is not pulled off either
+    fg[beside] = UNSURE
+    assert len(mismatch(covered, fg, 15.0).model) == 0
+    fg[beside] = BACKDROP
+    assert len(mismatch(covered, fg, 15.0).model) > 0
+
+
+def test_a_foreground_map_on_a_coarser_level_keeps_its_codes():
+    shape = (64, 96)
+    fg = np.full(shape, BACKDROP, np.uint8)
+    fg[_disc(shape, (30, 30), 12)] = FOREGROUND
+    fg[_disc(shape, (70, 30), 12)] = UNSURE
+    lv = at_level(fg, 2)
+    assert lv.shape == (16, 24)
+    assert lv[7, 7] == FOREGROUND and lv[7, 17] == UNSURE and lv[1, 12] == BACKDROP
+    np.testing.assert_array_equal(at_level(fg == FOREGROUND, 2) == FOREGROUND,
+                                  lv == FOREGROUND)
+
+
 def test_a_backdrop_that_moves_is_not_still():
     rng = np.random.default_rng(1)
     wall = cv2.GaussianBlur(rng.uniform(0, 1, (120, 220)).astype(np.float32), (0, 0), 1.5)
     frames = [wall[:, 7 * k: 7 * k + 160] for k in range(8)]  # a camera panning
     body = _disc((120, 160), (80, 60), 15)
-    assert not Backdrop(frames[0], body, frames[1:]).still
+    assert not Backdrop(frames[0], body, [(f, None) for f in frames[1:]]).still
 
 
 def test_the_silhouette_pulls_in_a_limb_beyond_the_reach_of_brightness():
