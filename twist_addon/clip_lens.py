@@ -6,12 +6,15 @@ the bottom row and pixel centres on integers, normalised about the principal poi
 focal length in pixels, (x, y) -> (x d(r) + tx, y d(r) + ty) with r^2 = x^2 + y^2:
 
 - Polynomial: d = 1 + k1 r^2 + k2 r^4 + k3 r^6, no tangential terms;
-- Brown: d adds k4 r^8; tx = p1 (r^2 + 2 x^2) + 2 p2 x y, ty = p2 (r^2 + 2 y^2) + 2 p1 x y.
+- Division: d = 1 / (1 + k1 r^2 + k2 r^4), no tangential terms;
+- Brown: d = 1 + k1 r^2 + ... + k4 r^8; tx = p1 (r^2 + 2 x^2) + 2 p2 x y,
+  ty = p2 (r^2 + 2 y^2) + 2 p1 x y.
 
-With y down (OpenCV's pixels, ``core.lens``) the radial part is unchanged and Brown's
-tangential part is OpenCV's with p1 = -Brown's p2 and p2 = Brown's p1 (the y flip turns the
-sign of every term odd in y). Blender's Division and Nuke models, Brown's r^8 term and
-non-square pixels have no OpenCV counterpart: such footage is tracked as filmed, with a note.
+With y down (OpenCV's pixels, ``core.lens``) the radial part is unchanged (Division is
+OpenCV's rational model with only the denominator's k4, k5) and Brown's tangential part is
+OpenCV's with p1 = -Brown's p2 and p2 = Brown's p1 (the y flip turns the sign of every term
+odd in y). Blender's Nuke model, Brown's r^8 term and non-square pixels have no OpenCV
+counterpart: such footage is tracked as filmed, with a note.
 """
 
 from __future__ import annotations
@@ -41,14 +44,16 @@ def _coefficients(tc) -> tuple[float, ...]:
 
 
 def opencv_lens(clip) -> tuple[np.ndarray, np.ndarray] | str:
-    """The clip's lens as OpenCV's K (3, 3) and distortion (k1, k2, p1, p2, k3) on the clip's
-    pixels (x right, y down, origin at the top-left pixel's centre); or, where OpenCV's model
-    cannot hold it, why not."""
+    """The clip's lens as OpenCV's K (3, 3) and distortion (k1, k2, p1, p2, k3[, k4, k5,
+    k6]) on the clip's pixels (x right, y down, origin at the top-left pixel's centre); or,
+    where OpenCV's model cannot hold it, why not."""
     tc = clip.tracking.camera
     if abs(tc.pixel_aspect - 1.0) > 1e-6:
         return f"its pixels are not square (aspect {tc.pixel_aspect:g})"
     if tc.distortion_model == "POLYNOMIAL":
         dist = [tc.k1, tc.k2, 0.0, 0.0, tc.k3]
+    elif tc.distortion_model == "DIVISION":
+        dist = [0.0, 0.0, 0.0, 0.0, 0.0, tc.division_k1, tc.division_k2, 0.0]
     elif tc.distortion_model == "BROWN" and abs(tc.brown_k4) <= 1e-9:
         dist = [tc.brown_k1, tc.brown_k2, -tc.brown_p2, tc.brown_p1, tc.brown_k3]
     else:
@@ -77,8 +82,9 @@ def undistorted(view_pg, images) -> tuple[object, str]:
     if isinstance(lens, str):
         return images, (f"the clip '{clip.name}' behind '{cam.name}' has lens distortion that "
                         f"the tracker does not undo ({lens}): it tracked the footage as if "
-                        "through an ideal lens (give the clip Polynomial or Brown distortion, "
-                        "render it undistorted, or add the views from a calibration file)")
+                        "through an ideal lens (give the clip Polynomial, Division or Brown "
+                        "distortion, render it undistorted, or add the views from a "
+                        "calibration file)")
     first = images[0] if isinstance(images[0], np.ndarray) else load_grey(images[0])
     if tuple(clip.size) != (first.shape[1], first.shape[0]):
         raise BridgeError(f"the clip '{clip.name}' behind '{cam.name}' is {clip.size[0]}x"

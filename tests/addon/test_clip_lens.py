@@ -21,6 +21,7 @@ VIEWS = ["lateral", "endon", "oblique60"]
 FOCAL, CENTRE = 520.0, (251.0, 171.0)  # pixels; the centre with y up from the bottom row
 LENSES = {
     "POLYNOMIAL": {"k1": -0.22, "k2": 0.06, "k3": 0.01},
+    "DIVISION": {"division_k1": 0.18, "division_k2": -0.03},
     "BROWN": {"brown_k1": -0.2, "brown_k2": 0.05, "brown_k3": 0.0, "brown_k4": 0.0,
               "brown_p1": 0.006, "brown_p2": -0.004},
 }
@@ -32,6 +33,9 @@ def blender_distort(pts: np.ndarray, model: str, k: dict) -> np.ndarray:
     r2 = x * x + y * y
     if model == "POLYNOMIAL":
         d = 1 + r2 * (k["k1"] + r2 * (k["k2"] + r2 * k["k3"]))
+        tx = ty = 0.0
+    elif model == "DIVISION":
+        d = 1 / (1 + r2 * (k["division_k1"] + r2 * k["division_k2"]))
         tx = ty = 0.0
     else:
         d = 1 + r2 * (k["brown_k1"] + r2 * (k["brown_k2"] + r2 * (k["brown_k3"]
@@ -98,7 +102,7 @@ def test_footage_behind_a_distorting_clip_is_read_undistorted_and_tracked(
     """The lateral view's footage filmed through the Brown lens, the clip behind its camera
     holding that lens: the tracker reads each frame as the ideal lens saw it (the rendered
     frame, within resampling twice), Track says so, and the legs follow the capture. A
-    model OpenCV cannot hold (Division) is tracked as filmed, with a note saying so."""
+    model OpenCV cannot hold (Nuke) is tracked as filmed, with a note saying so."""
     bpy = bpy_module
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene, arm = tracking_scene(bpy, footage, VIEWS, 6)
@@ -136,9 +140,9 @@ def test_footage_behind_a_distorting_clip_is_read_undistorted_and_tracked(
 
     bpy.ops.twist.clear_track()
     scene.frame_set(1)
-    clip.tracking.camera.distortion_model = "DIVISION"
-    clip.tracking.camera.division_k1 = -0.1
+    clip.tracking.camera.distortion_model = "NUKE"
+    clip.tracking.camera.nuke_k1 = -0.1
     assert bpy.ops.twist.track() == {"FINISHED"}
     assert (f"the clip '{clip.name}' behind '{view.camera.name}' has lens distortion that the "
-            "tracker does not undo (its distortion model (Division) is not one the tracker "
+            "tracker does not undo (its distortion model (Nuke) is not one the tracker "
             "can undo)") in scene.twist.result.notes
