@@ -113,6 +113,12 @@ class _Samples:
 
 
 
+def _grey_and_colour(source) -> tuple[np.ndarray, np.ndarray | None]:
+    """An image (path or array) as grey float and colour (``core.image``)."""
+    img = source if isinstance(source, np.ndarray) else imagelib.load_image(source)
+    return imagelib.to_grey(img), imagelib.to_colour(img)
+
+
 class FrameFit:
     """Fits a body (a skeleton with blobs) to one new frame at a time in the footage of one
     or more views, holding what the frames share: the key frame's pixels, the silhouette's
@@ -125,9 +131,11 @@ class FrameFit:
         mode: str = INDEPENDENT,
         settings: TrackerSettings | None = None,
         moving_views: Sequence[int] = (),
+        clean_plates: Sequence | None = None,
     ):
         """``moving_views``: the views whose camera moves (their backdrop with it: no
-        silhouette there)."""
+        silhouette there). ``clean_plates``: per view, an image (path or array) of its
+        scene without the body, the backdrop of its silhouette, or None."""
         if mode not in (CALIBRATED, INDEPENDENT):
             raise InputError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
         if not skeleton.blobs:
@@ -140,7 +148,9 @@ class FrameFit:
         # the key frame's points by (frame, view, level), kept while the key frame is
         self.key_sets: dict[tuple[int, int, int], PointSet] = {}
         # the backdrops, once the key frame is known
-        self._cue = sil.SilhouetteCue(self.seq, moving_views)
+        self.clean_plates = list(clean_plates or [None] * self.seq.n_views)
+        self._cue = sil.SilhouetteCue(self.seq, moving_views, [
+            None if p is None else _grey_and_colour(p) for p in self.clean_plates])
         self.notes: list[str] = []  # what the user should know about the run
         self._use(skeleton)
 

@@ -21,7 +21,7 @@ from .bvh import BvhError, BvhFile, read_bvh
 from .calibration import CalibrationError, read_calibration
 from .camera import Camera, Pinhole, View, intrinsics_problem
 from .errors import InputError
-from .image import ImageError
+from .image import ImageError, load_image
 from .init_fit import FitError, clicked_point
 from .lens import Undistorted, undistort_points
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, pose_from_bvh
@@ -47,6 +47,8 @@ class Job:
     corrections: dict[int, BodyPose] = dataclasses.field(default_factory=dict)  # by image
     moving: list = dataclasses.field(default_factory=list)  # per view: its camera per frame
     # where it moves, else None (``Tracker``'s ``moving``)
+    clean_plates: list = dataclasses.field(default_factory=list)  # per view: an image of
+    # its scene without the body, or None (``Tracker``'s ``clean_plates``)
 
 
 def _field(d: dict, key: str, where: str, kind=None):
@@ -194,6 +196,22 @@ def _images(spec, base: Path, where: str):
             raise JobError(f"{where}: {len(missing)} image(s) not found, first: {missing[0]}")
         return paths
     raise JobError(f"{where}: expected a movie file, a glob pattern or a list of image paths")
+
+
+def _clean_plate(spec, base: Path, where: str, cam: Camera, dist):
+    """A view's ``backdrop``: an image of its scene without the body (undistorted like its
+    footage), or None when not given."""
+    if spec is None:
+        return None
+    path = base / spec if isinstance(spec, str) else None
+    if path is None or not path.is_file():
+        raise JobError(f"{where}: expected the path of an image of the scene without the "
+                       f"body (relative to {base}), got {spec!r}")
+    try:
+        img = load_image(path)
+    except ImageError as e:
+        raise JobError(f"{where}: {e}") from None
+    return str(path) if dist is None else Undistorted([img], cam.K, dist)[0]
 
 
 def _reaches_out(sk: Skeleton, j: int) -> bool:
@@ -408,6 +426,8 @@ def load_job(path: str | Path) -> Job:
                       f"{where}.views[{i}].images") for i, v in enumerate(views)]
     images = [x if dist is None else Undistorted(x, cam.K, dist)
               for x, cam, dist in zip(images, cameras, dists)]
+    plates = [_clean_plate(v.get("backdrop"), base, f"{where}.views[{i}].backdrop", cam, dist)
+              for i, (v, cam, dist) in enumerate(zip(views, cameras, dists))]
     counts = {len(x) for x in images}
     if len(counts) > 1:
         raise JobError(f"{where}.views: every view needs the same number of frames, got "
@@ -433,7 +453,8 @@ def load_job(path: str | Path) -> Job:
     _in_front(pose, sk, f"{where}.initial")
     corrections = _corrections(d.get("corrections", []), sk, bvh, bvh_path, base, cameras,
                                len(images[0]), f"{where}.corrections")
-    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections, moving)
+    return Job(sk, bvh, pose, images, cameras, mode, settings, float(ft), corrections, moving,
+               plates)
 
 
 @dataclass

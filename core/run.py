@@ -22,7 +22,8 @@ def run_job(
 ) -> TrackResult:
     """Track every frame of the job's footage from its first frame (a corrected frame takes
     its given pose)."""
-    tracker = Tracker(job.skeleton, job.images, job.mode, job.settings, job.moving or None)
+    tracker = Tracker(job.skeleton, job.images, job.mode, job.settings, job.moving or None,
+                      job.clean_plates or None)
     frames = list(range(len(job.images[0])))
     return track(tracker, job.initial, frames, progress, cancel, job.corrections)
 

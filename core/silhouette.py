@@ -51,18 +51,23 @@ class Backdrop:
 
     def __init__(self, grey: np.ndarray, body: np.ndarray,
                  frames: Iterable[tuple[np.ndarray, np.ndarray | None]] = (),
-                 margin: int = BODY_MARGIN, colour: np.ndarray | None = None):
-        """``grey`` float (H, W) and ``colour`` uint8 BGR (H, W, 3) or None: the key frame;
-        ``body``: its body's pixels; ``frames``: (grey, colour) of other frames."""
+                 margin: int = BODY_MARGIN, colour: np.ndarray | None = None,
+                 clean: bool = False):
+        """``grey`` float (H, W) and ``colour`` uint8 BGR (H, W, 3) or None: the key frame,
+        or, ``clean``, a clean plate (the scene without the body: nothing to paint out);
+        ``body``: the key frame's body pixels; ``frames``: (grey, colour) of other frames."""
         grey = np.asarray(grey, np.float32)
         self.margin = margin
-        self.unseen = self._widen(body)  # pixels whose backdrop is only painted in
-        img8 = np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8)
-        holes = self.unseen.astype(np.uint8)
-        self.image = cv2.inpaint(img8, holes, INPAINT_RADIUS,
-                                 cv2.INPAINT_TELEA).astype(np.float32) / 255
-        self.colour = None if colour is None else cv2.inpaint(colour, holes, INPAINT_RADIUS,
-                                                              cv2.INPAINT_TELEA)
+        # pixels whose backdrop is only painted in
+        self.unseen = np.zeros(body.shape, bool) if clean else self._widen(body)
+        self.image, self.colour = grey.copy(), None if colour is None else colour.copy()
+        if self.unseen.any():
+            holes = self.unseen.astype(np.uint8)
+            img8 = np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8)
+            self.image = cv2.inpaint(img8, holes, INPAINT_RADIUS,
+                                     cv2.INPAINT_TELEA).astype(np.float32) / 255
+            if colour is not None:
+                self.colour = cv2.inpaint(colour, holes, INPAINT_RADIUS, cv2.INPAINT_TELEA)
         noise = np.abs(grey - cv2.medianBlur(grey, 3))[~self.unseen]
         self.threshold = max(MIN_CONTRAST, 6 * 1.4826 * float(np.median(noise)))
         frames = [(np.asarray(f, np.float32), c) for f, c in frames]
@@ -239,16 +244,18 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
 
 
 class SilhouetteCue:
-    """One run's silhouette state: each view's backdrop, learned from the key frame the
-    first time it is asked for and then from every tracked frame, and the foregrounds of
-    the frame being tracked. The tracker says where the body is (its blobs' pixels, full
-    resolution); this object knows only images. A view whose camera is known to move, or
-    whose footage around the body keeps changing (a camera or light moving unannounced),
-    has no backdrop, and a note says so."""
+    """One run's silhouette state: each view's backdrop (its clean plate where one is given,
+    else the key frame's, made the first time it is asked for and learned from every
+    tracked frame), and the foregrounds of the frame being tracked. The tracker says where
+    the body is (its blobs' pixels, full resolution); this object knows only images. A view
+    whose camera is known to move, or whose footage around the body keeps changing (a
+    camera or light moving unannounced), has no backdrop, and a note says so."""
 
-    def __init__(self, seq, moving: Iterable[int] = ()):
+    def __init__(self, seq, moving: Iterable[int] = (), plates=None):
+        """``plates``: per view, its clean plate as (grey, colour or None), or None."""
         self.seq = seq  # the run's ImageSequence
         self.moving = frozenset(moving)  # views whose camera moves
+        self.plates = list(plates) if plates is not None else [None] * seq.n_views
         self.backdrops: list[Backdrop | None] | None = None  # per view; None: not started
         self._foregrounds: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
 
@@ -261,9 +268,10 @@ class SilhouetteCue:
         return self.backdrops is not None
 
     def start(self, key_frame: int, bodies: list[np.ndarray], margins: list[int]) -> list[str]:
-        """Each view's backdrop from the key frame with the body (``bodies``: per view, its
-        pixels on the key frame) painted out ``margins`` pixels wide, checked against frames
-        spread over the footage; returns the notes on views whose backdrop does not hold."""
+        """Each view's backdrop: its clean plate, or the key frame with the body
+        (``bodies``: per view, its pixels on the key frame) painted out ``margins`` pixels
+        wide; checked against frames spread over the footage. Returns the notes on views
+        whose backdrop does not hold."""
         others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
         self.backdrops, notes = [], []
         for c, (body, margin) in enumerate(zip(bodies, margins)):
@@ -272,9 +280,11 @@ class SilhouetteCue:
                              "its silhouette is not used")
                 self.backdrops.append(None)
                 continue
-            backdrop = Backdrop(self.seq.grey(c, key_frame), body, (
+            grey, colour = self.plates[c] or (self.seq.grey(c, key_frame),
+                                              self.seq.colour(c, key_frame))
+            backdrop = Backdrop(grey, body, (
                 self.seq.peek(c, f) for f in sorted(set(others) - {key_frame})), margin,
-                self.seq.colour(c, key_frame))
+                colour, clean=self.plates[c] is not None)
             if not backdrop.still:
                 notes.append(f"view {c + 1}: the footage around the body changes from frame "
                              "to frame far more than a body's outline (a moving camera or "

@@ -70,12 +70,14 @@ class Tracker(FrameFit):
 
     def __init__(self, skeleton: Skeleton, images: Sequence[Sequence], mode: str = INDEPENDENT,
                  settings: TrackerSettings | None = None,
-                 moving: Sequence[Sequence[Camera] | None] | None = None):
+                 moving: Sequence[Sequence[Camera] | None] | None = None,
+                 clean_plates: Sequence | None = None):
         """``moving``: per view, its camera on every frame where the camera moves (None for
-        a view whose camera stands still); calibrated mode only."""
+        a view whose camera stands still); calibrated mode only. ``clean_plates``: per
+        view, an image of its scene without the body, or None (``FrameFit``)."""
         moving = list(moving) if moving is not None else [None] * len(images)
         super().__init__(skeleton, images, mode, settings,
-                         [c for c, m in enumerate(moving) if m is not None])
+                         [c for c, m in enumerate(moving) if m is not None], clean_plates)
         self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
         self.moving = moving
         if any(m is not None for m in self.moving) and mode != CALIBRATED:
@@ -95,16 +97,23 @@ class Tracker(FrameFit):
         return out
 
     def _check_start(self, initial: BodyPose, frame: int) -> None:
-        """InputError unless every view's image files can be read and share one size, that
-        size fits the pyramid asked for, and the first pose puts the body inside every
-        view's image (a camera looking away, or a pose far off, would otherwise read as a
-        divergence on the next frame)."""
+        """InputError unless every view's image files can be read and share one size (its
+        clean plate's too), that size fits the pyramid asked for, and the first pose puts
+        the body inside every view's image (a camera looking away, or a pose far off, would
+        otherwise read as a divergence on the next frame)."""
         for c in range(self.seq.n_views):
             imagelib.check_footage(self.seq.images[c], f"view {c + 1}'s footage")
         kin = Kinematics(self.skeleton, initial)
         centres = kin.world_points(self._blobs.joint, self._blobs.centre)
         for c, view in enumerate(initial.views):
             h, w = self.seq.grey(c, frame).shape
+            plate = self._cue.plates[c]
+            if plate is not None and plate[0].shape != (h, w):
+                name = self.clean_plates[c]
+                name = "its clean plate" if isinstance(name, np.ndarray) else str(name)
+                raise InputError(f"{name}: view {c + 1}'s clean plate is "
+                                 f"{plate[0].shape[1]}x{plate[0].shape[0]}, its footage "
+                                 f"{w}x{h}: give the plate from the same camera, uncropped")
             most = int(np.log2(min(h, w) / MIN_LEVEL_PIXELS)) + 1
             if self.settings.levels > most:
                 raise InputError(

@@ -57,6 +57,7 @@ class TWIST_PT_views(_TwistPanel, bpy.types.Panel):
         if tw.views:
             view = tw.views[tw.active_view]
             layout.prop(view, "first_frame")
+            layout.prop(view, "backdrop")
         layout.prop(tw, "mode")
 
 

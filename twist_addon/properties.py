@@ -79,6 +79,12 @@ class TWIST_PG_view(bpy.types.PropertyGroup):
         description="The footage's frames: a glob such as //walk/side_*.png (// is the .blend's "
                     "folder), read in name order")
     first_frame: first_frame_property()
+    backdrop: bpy.props.StringProperty(
+        name="Clean Plate", subtype="FILE_PATH", options={"PATH_SUPPORTS_BLEND_RELATIVE"},
+        description="Optional: an image of this camera's scene without the body, the "
+                    "footage's size. The silhouette's backdrop is then this image, not the "
+                    "first frame with the body painted out: give one where the body never "
+                    "leaves its place")
     markers: bpy.props.CollectionProperty(type=TWIST_PG_marker)
 
 

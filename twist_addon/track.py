@@ -29,7 +29,7 @@ from .bridge import (
 from .clip_lens import undistorted
 from .errors import INPUT_ERRORS
 from .properties import settings_from_properties
-from .views import footage_frames
+from .views import clean_plate, footage_frames
 
 
 @dataclass
@@ -69,7 +69,7 @@ class TrackSession:
             frames = list(range(cur, scene.frame_start - 1, -1))
         if len(frames) < 2:
             raise BridgeError(f"nothing to track {tw.direction.lower()} from frame {cur}")
-        views, images, moving, notes = [], [], [], []
+        views, images, moving, plates, notes = [], [], [], [], []
         for v in tw.views:
             if v.camera is None:
                 raise BridgeError("a view has no camera; pick its camera or remove the view")
@@ -78,11 +78,12 @@ class TrackSession:
             images.append(footage)
             notes += [note] if note else []
             moving.append(camera_path(v.camera, scene, frames))
+            plates.append(clean_plate(v))
         mode = tracking_mode(scene, views, moving)
         sk = tracked_skeleton(arm)
         settings = settings_from_properties(tw.tracker)
         # the tracker indexes frames 0..n-1 in tracking order, the cameras' paths too
-        tracker = Tracker(sk, images, mode, settings, moving)
+        tracker = Tracker(sk, images, mode, settings, moving, plates)
         user_keys = keyframes.user_keys(arm, sk)
         corrections = {}
         for i, f in enumerate(frames[1:], 1):

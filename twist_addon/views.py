@@ -19,6 +19,7 @@ from ..core.lens import Undistorted
 from ..core.plate import write_frames
 from ..core.video import VideoFrames, is_video
 from .bridge import BridgeError, place_pinhole
+from .clip_lens import undistorted
 from .properties import first_frame_property
 
 
@@ -44,6 +45,21 @@ def footage_frames(view_pg, frames: list[int]) -> list:
     if isinstance(paths, list):
         return [paths[i] for i in indices]
     return paths.select(indices)
+
+
+def clean_plate(view_pg):
+    """The view's clean plate (its scene without the body) as the tracker reads it: the
+    file, read through the lens of the movie clip behind the camera like its footage; None
+    when not set. BridgeError when the file is missing."""
+    if not view_pg.backdrop:
+        return None
+    path = Path(bpy.path.abspath(view_pg.backdrop))
+    if not path.is_file():
+        cam = view_pg.camera.name if view_pg.camera else "(no camera)"
+        raise BridgeError(f"{path}: the clean plate of the view of '{cam}' is not found; pick "
+                          "the image again, or clear it to paint the backdrop from the first "
+                          "frame")
+    return undistorted(view_pg, [str(path)])[0][0]
 
 
 def add_footage_view(context, path: Path, first_frame: int) -> str:

@@ -11,7 +11,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "bench"))
 
-from walk_footage import JOINTS, render, tracking_scene  # noqa: E402
+from walk_footage import JOINTS, backdrop, render, tracking_scene  # noqa: E402
 
 from core import se3  # noqa: E402
 from support.layout import Recorder, draw_panel  # noqa: E402
@@ -400,3 +400,30 @@ def test_a_refine_round_that_fails_keeps_the_rounds_before_it(bpy_module, regist
                                atol=1e-6)
     keyed = _channel_frames(arm)
     assert all(set(range(2, 22)) <= {f for f, _ in keyed[b]} for b in TRACKED)
+
+
+def test_clean_plates_are_read_as_the_views_backdrops(bpy_module, registered, footage,
+                                                      tmp_path):
+    """Each view given the stage without the body (the renderer's backdrop): Track reads
+    them as the silhouette's backdrops and the legs follow the capture; a plate that is not
+    there is named before anything is keyed."""
+    import cv2
+
+    bpy = bpy_module
+    scene, arm = _scene(bpy, registered, footage)
+    plate = tmp_path / "stage.png"
+    cv2.imwrite(str(plate), backdrop().astype(np.uint8))
+    for view in scene.twist.views:
+        view.backdrop = str(plate)
+    session = registered.twist_addon.track.TrackSession.from_scene(scene)
+    assert session.tracker.clean_plates == [str(plate)] * len(VIEWS)
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    legs = leg_errors(scene, registered.twist_addon.bridge, arm, footage, range(2, 7))
+    assert np.all(legs < 8.0), legs
+    bpy.ops.twist.clear_track()
+    scene.frame_set(1)
+    scene.twist.views[1].backdrop = str(tmp_path / "nowhere.png")
+    with pytest.raises(RuntimeError, match="nowhere.png: the clean plate of the view of "
+                                           f"'{scene.twist.views[1].camera.name}' is not found"):
+        bpy.ops.twist.track()
+    assert not any(_channel_frames(arm).values())  # nothing keyed

@@ -262,6 +262,8 @@ def test_a_corrected_frame_takes_its_given_pose_and_the_others_are_tracked(foota
         (lambda j: j.update(corrections=[{"image": 1, "bvh": "walk.bvh"}] * 2),
          r"corrections\[1\].image: frame 1 is corrected twice"),
         (lambda j: j.update(corrections={"image": 1}), "job.json.corrections: expected a list"),
+        (lambda j: j["views"][0].update(backdrop="empty.png"),
+         r"views\[0\].backdrop: expected the path of an image of the scene without the body"),
     ],
 )
 def test_malformed_jobs_get_one_clear_error(footage, tmp_path, change, message):
@@ -278,6 +280,31 @@ def test_malformed_jobs_get_one_clear_error(footage, tmp_path, change, message):
     finally:
         broken.write_text(good)
     assert proc.returncode == 2 and proc.stderr.startswith("error: job.json")
+    assert not (tmp_path / "x.bvh").exists()
+
+
+def test_clean_plates_are_the_backdrops_and_one_of_another_size_is_named(footage, tmp_path):
+    """Each view given its scene without the body (the renderer's plain background): the
+    run tracks as well; a plate cropped to another size stops it before any frame."""
+    folder, job = footage
+    with_plates = json.loads(json.dumps(job))
+    for v in with_plates["views"]:
+        name = v["images"].split("/")[0] + "_plate.png"
+        cv2.imwrite(str(folder / name), np.full((300, 320), round(0.3 * 255), np.uint8))
+        v["backdrop"] = name
+    job_path = folder / "job_plates.json"
+    job_path.write_text(json.dumps(with_plates))
+    out = tmp_path / "out.bvh"
+    proc = _run("track", job_path, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    R_true, p_true = read_bvh(folder / "walk.bvh").poses()
+    sk = load_job(job_path).skeleton
+    assert np.all(_leg_errors(sk, read_bvh(out).poses(), (R_true, p_true)) < 2.0)
+    plate = folder / with_plates["views"][1]["backdrop"]
+    cv2.imwrite(str(plate), np.full((300, 300), 77, np.uint8))
+    proc = _run("track", job_path, "--out", tmp_path / "x.bvh")
+    assert proc.returncode == 2
+    assert f"{plate}: view 2's clean plate is 300x300, its footage 320x300" in proc.stderr
     assert not (tmp_path / "x.bvh").exists()
 
 

@@ -4,8 +4,10 @@ limb caught beyond brightness's reach."""
 
 import cv2
 import numpy as np
+import pytest
 
 from core import se3
+from core.errors import InputError
 from core.pose import INDEPENDENT, BodyPose, apply_update
 from core.settings import TrackerSettings
 from core.silhouette import (
@@ -234,3 +236,43 @@ def test_the_tracker_leaves_out_and_notes_a_view_whose_backdrop_moves():
                          "first pose that does not cover the body), so its silhouette is "
                          "not used"]
     assert len(res.frames) == 6 and not res.diverged_frames
+
+
+def test_a_clean_plate_is_the_backdrop_where_the_body_never_leaves():
+    """A body that stays where it is (a disc growing and shrinking) on a ruled wall: the key
+    frame's backdrop only guesses the wall behind it, and when the body shrinks the guessed
+    ring reads as foreground; a clean plate (the wall alone) gives the body exactly."""
+    rng = np.random.default_rng(5)
+    shape = (120, 160)
+    wall = cv2.GaussianBlur(rng.uniform(0, 0.3, shape).astype(np.float32), (0, 0), 2)
+    wall[::6] = wall[:, ::6] = 0.6
+
+    def frame(r):
+        img = wall.copy()
+        img[_disc(shape, (80, 60), r)] = 0.95
+        return img + rng.normal(0, 0.005, shape).astype(np.float32), _disc(shape, (80, 60), r)
+
+    (key, body), (small, truth) = frame(24), frame(12)
+    others = [(frame(r)[0], None) for r in (20, 16, 22)]
+
+    def iou(fg):
+        fg = fg == FOREGROUND
+        return (fg & truth).sum() / (fg | truth).sum()
+
+    painted = Backdrop(key, body, others)
+    clean = Backdrop(wall, body, others, clean=True)
+    assert not clean.unseen.any() and clean.still
+    assert iou(clean.foreground(small)) > 0.97
+    assert iou(painted.foreground(small)) < 0.8
+
+
+def test_a_clean_plate_of_another_size_is_refused_before_tracking():
+    sk = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
+    view = side_view(yaw_deg=0, height=0.0, center=(110, 180))
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3), [view])
+    frames = [[render(sk, pose, 0, background=0.05) for _ in range(3)]]
+    plate = np.full(frames[0][0].shape, 0.05, np.float32)
+    with pytest.raises(InputError, match="view 1's clean plate is 300x360, its footage 320x360"):
+        track(Tracker(sk, frames, INDEPENDENT, clean_plates=[plate[:, :300]]), pose, range(3))
+    res = track(Tracker(sk, frames, INDEPENDENT, clean_plates=[plate]), pose, range(3))
+    assert len(res.frames) == 3 and not res.diverged_frames and not res.notes
