@@ -1,18 +1,19 @@
 """The body's silhouette against a still backdrop: a cue whose basin is as wide as a limb is
 long, where brightness constancy only reaches a blob's width.
 
-Each view's backdrop is the key frame with the body taken out (see ``Backdrop``); a pixel
-is foreground where it differs from the backdrop by more than a threshold set from the
-image's own noise (the cameras must stand still). In colour footage, a changed pixel whose
-colour is the backdrop's, darkened or lightened as a shadow does, is unsure: the body's
-own cast shadow, or one the key frame held, on a backdrop whose colour shows it (on a
-colourless one a shadow cannot be told from a grey body, and it stays foreground). Two
-chamfer terms compare the blobs' projection (a label map) with the foreground, each in both
-directions: foreground pixels no blob covers pull the nearest covered pixel toward them,
-and covered pixels off the foreground are pulled to the nearest foreground pixel; unsure
-pixels do neither. Distances are in level pixels, capped so that clutter far from the body
-cannot pull. A foreground map holds one code per pixel: ``BACKDROP``, ``FOREGROUND`` or
-``UNSURE`` (a boolean mask is a map with no unsure pixels).
+Each view's backdrop is the key frame with the body taken out (see ``Backdrop``), or the
+clean plate the user gives (the scene without the body); a pixel is foreground where it
+differs from the backdrop by more than a threshold set from the image's own noise (the
+cameras must stand still). In colour footage, a changed pixel whose colour is the
+backdrop's, darkened or lightened as a shadow does, is unsure: the body's own cast shadow,
+or one the key frame held, on a backdrop whose colour shows it (on a colourless one a
+shadow cannot be told from a grey body, and it stays foreground). Two chamfer terms compare
+the blobs' projection (a label map) with the foreground, each in both directions:
+foreground pixels no blob covers pull the nearest covered pixel toward them, and covered
+pixels off the foreground are pulled to the nearest foreground pixel; unsure pixels do
+neither. Distances are in level pixels, capped so that clutter far from the body cannot
+pull. A foreground map holds one code per pixel: ``BACKDROP``, ``FOREGROUND`` or ``UNSURE``
+(a boolean mask is a map with no unsure pixels).
 """
 
 from __future__ import annotations
@@ -80,17 +81,15 @@ class Backdrop:
         """The median colour distortion (``_chroma``) of frames against the backdrop over
         the seen pixels they leave the same (every ``NOISE_STRIDE``-th row and column: a
         median needs no more); None without colour frames to measure it."""
-        if self.colour is None or not any(c is not None and c.shape == self.colour.shape
-                                          for _, c in frames):
+        if self.colour is None:
             return None
-        found = []
+        k = NOISE_STRIDE
+        found = [np.zeros(0)]
         for grey, c in frames:
-            if c is None or c.shape != self.colour.shape:
-                continue
-            k = NOISE_STRIDE
-            same = (np.abs(grey[::k, ::k] - self.image[::k, ::k]) <= self.threshold) \
-                & ~self.unseen[::k, ::k]
-            found.append(_chroma(c[::k, ::k][same], self.colour[::k, ::k][same])[0])
+            if c is not None and c.shape == self.colour.shape:
+                same = (np.abs(grey[::k, ::k] - self.image[::k, ::k]) <= self.threshold) \
+                    & ~self.unseen[::k, ::k]
+                found.append(_chroma(c[::k, ::k][same], self.colour[::k, ::k][same])[0])
         found = np.concatenate(found)
         return float(np.median(found)) if len(found) else None
 
@@ -206,13 +205,12 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
              uncovered_weight: float = UNCOVERED_WEIGHT,
              nearest_fg: NearestPixel | None = None) -> Mismatch:
     """Both chamfer terms between a label map (H, W; -1 where no blob) and a foreground map
-    (unsure pixels take no part): a
-    pixel ``d`` from its match costs (min(d, cap) - slack)^2 if positive, and wants to move
-    d - slack toward it (the slack forgives outline noise and the holes a body shows where
-    it happens to match the backdrop). Uncovered foreground weighs ``uncovered_weight``:
-    it also comes from what the blobs do not model, and pulled the shanks toward the feet.
-    ``nearest_fg``: the foreground's ``NearestPixel`` (its mask is ``fg == FOREGROUND``), to
-    share between label maps."""
+    (unsure pixels take no part): a pixel ``d`` from its match costs (min(d, cap) - slack)^2
+    if positive, and wants to move d - slack toward it (the slack forgives outline noise and
+    the holes a body shows where it happens to match the backdrop). Uncovered foreground
+    weighs ``uncovered_weight``: it also comes from what the blobs do not model, and pulled
+    the shanks toward the feet. ``nearest_fg``: the foreground's ``NearestPixel`` (its mask
+    is ``fg == FOREGROUND``), to share between label maps."""
     covered = labels >= 0
     background = fg == BACKDROP
     fg = fg == FOREGROUND
