@@ -109,9 +109,9 @@ class Tracker(FrameFit):
             h, w = self.seq.grey(c, frame).shape
             plate = self._cue.plates[c]
             if plate is not None and plate[0].shape != (h, w):
-                name = self.clean_plates[c]
-                name = "its clean plate" if isinstance(name, np.ndarray) else str(name)
-                raise InputError(f"{name}: view {c + 1}'s clean plate is "
+                source = self.clean_plates[c]
+                where = "" if isinstance(source, np.ndarray) else f"{source}: "
+                raise InputError(f"{where}view {c + 1}'s clean plate is "
                                  f"{plate[0].shape[1]}x{plate[0].shape[0]}, its footage "
                                  f"{w}x{h}: give the plate from the same camera, uncropped")
             most = int(np.log2(min(h, w) / MIN_LEVEL_PIXELS)) + 1
