@@ -113,12 +113,6 @@ class _Samples:
 
 
 
-def _grey_and_colour(source) -> tuple[np.ndarray, np.ndarray | None]:
-    """An image (path or array) as grey float and colour (``core.image``)."""
-    img = source if isinstance(source, np.ndarray) else imagelib.load_image(source)
-    return imagelib.to_grey(img), imagelib.to_colour(img)
-
-
 class FrameFit:
     """Fits a body (a skeleton with blobs) to one new frame at a time in the footage of one
     or more views, holding what the frames share: the key frame's pixels, the silhouette's
@@ -150,7 +144,7 @@ class FrameFit:
         # the backdrops, once the key frame is known
         self.clean_plates = list(clean_plates or [None] * self.seq.n_views)
         self._cue = sil.SilhouetteCue(self.seq, moving_views, [
-            None if p is None else _grey_and_colour(p) for p in self.clean_plates])
+            None if p is None else imagelib.grey_and_colour(p) for p in self.clean_plates])
         self.notes: list[str] = []  # what the user should know about the run
         self._use(skeleton)
 

@@ -44,6 +44,17 @@ def load_grey(path: str | Path) -> np.ndarray:
     return to_grey(load_image(path))
 
 
+def read_source(source) -> np.ndarray:
+    """A frame given as a path (read as stored, ``load_image``) or as an array (itself)."""
+    return source if isinstance(source, np.ndarray) else load_image(source)
+
+
+def grey_and_colour(source) -> tuple[np.ndarray, np.ndarray | None]:
+    """A frame (path or array) as float32 grey and uint8 colour (None for grey footage)."""
+    img = read_source(source)
+    return to_grey(img), to_colour(img)
+
+
 def check_footage(paths, where: str) -> None:
     """ImageError naming the first of the image files ``paths`` (str or Path; other sources,
     a movie's frames or arrays, are not checked) that cannot be decoded, or that differs in
@@ -100,9 +111,7 @@ def to_float(img: np.ndarray) -> np.ndarray:
 def to_grey(img: np.ndarray) -> np.ndarray:
     """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 grey in [0, 1]."""
     img = to_float(img)
-    if img.ndim == 3:
-        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-    return np.ascontiguousarray(img)
+    return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY) if img.ndim == 3 else img
 
 
 def to_colour(img: np.ndarray) -> np.ndarray | None:

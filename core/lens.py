@@ -38,9 +38,7 @@ class Undistorted(Sequence):
     def __getitem__(self, i):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
-        src = self.source[i]
-        img = src if isinstance(src, np.ndarray) else imagelib.load_image(src)
-        return self.remap(imagelib.to_float(img))
+        return self.remap(imagelib.to_float(imagelib.read_source(self.source[i])))
 
     def remap(self, img: np.ndarray) -> np.ndarray:
         """An image (grey or colour) of the footage as filmed, undistorted."""

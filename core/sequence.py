@@ -105,9 +105,7 @@ class ImageSequence:
             self._pyramids.setdefault((c, frame), pyr)
 
     def _read(self, view: int, frame: int) -> tuple[np.ndarray, np.ndarray | None]:
-        src = self.images[view][frame]
-        img = src if isinstance(src, np.ndarray) else imagelib.load_image(src)
-        return imagelib.to_grey(img), imagelib.to_colour(img)
+        return imagelib.grey_and_colour(self.images[view][frame])
 
     def _build(self, view: int, grey: np.ndarray) -> list[imagelib.Level]:
         return imagelib.pyramid(grey, self.levels[view], highpass=self.highpass)

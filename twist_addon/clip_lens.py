@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.image import load_grey
+from ..core.image import read_source
 from ..core.lens import Undistorted
 from .bridge import BridgeError
 
@@ -85,12 +85,12 @@ def undistorted(view_pg, images) -> tuple[object, str]:
                         "through an ideal lens (give the clip Polynomial, Division or Brown "
                         "distortion, render it undistorted, or add the views from a "
                         "calibration file)")
-    first = images[0] if isinstance(images[0], np.ndarray) else load_grey(images[0])
-    if tuple(clip.size) != (first.shape[1], first.shape[0]):
+    height, width = read_source(images[0]).shape[:2]
+    if tuple(clip.size) != (width, height):
         raise BridgeError(f"the clip '{clip.name}' behind '{cam.name}' is {clip.size[0]}x"
-                          f"{clip.size[1]} but that view's footage is {first.shape[1]}x"
-                          f"{first.shape[0]}: its lens distortion is given for the clip's "
-                          "pixels; use the clip's own footage for the view")
+                          f"{clip.size[1]} but that view's footage is {width}x{height}: its "
+                          "lens distortion is given for the clip's pixels; use the clip's own "
+                          "footage for the view")
     return Undistorted(images, *lens), (
         f"the footage behind '{cam.name}' was undistorted through the lens of the clip "
         f"'{clip.name}' ({clip.tracking.camera.distortion_model.title()}) as it was read")
