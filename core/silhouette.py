@@ -138,10 +138,11 @@ class Backdrop:
         backdrop's colour is told from grey at that brightness (else a grey body would pass
         for its shadow)."""
         off, scale = _chroma(seen, backdrop)
-        grey = np.repeat(seen.astype(np.float32).mean(1, keepdims=True), 3, 1)
         tell = SHADOW_CHROMA * self.chroma_noise
-        return ((off <= tell) & (scale >= SHADOW_DEPTH) & (scale <= 1 / SHADOW_DEPTH)
-                & (_chroma(grey, backdrop)[0] > tell))
+        out = (off <= tell) & (scale >= SHADOW_DEPTH) & (scale <= 1 / SHADOW_DEPTH)
+        grey = np.repeat(seen[out].astype(np.float32).mean(1, keepdims=True), 3, 1)
+        out[out] = _chroma(grey, backdrop[out])[0] > tell  # only where the rest holds
+        return out
 
 
 def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
