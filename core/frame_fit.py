@@ -14,11 +14,12 @@ posterior. With still cameras, the blobs' outline is also held against the body'
 silhouette (``silhouette``): chamfer pulls in both directions whose reach is a limb's
 length, not a blob's width, so that a fast limb is caught and a lost one found again; and
 before refining, each limb is searched over a grid of turns against the silhouette
-(``core.search``), a turn kept where every view's pixels bear it out. The finished frame's
-limbs are checked against every view (``core.confidence``). Sizes in pixels are meant for a
-body about ``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that
-view's pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads
-every view where the body is about as large (``auto_scale``, ``core.scales``).
+(``core.search``), a turn kept where every view's pixels bear it out (the earlier frame's,
+or in two views or more the key frame's). The finished frame's limbs are checked against
+every view (``core.confidence``). Sizes in pixels are meant for a body about
+``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that view's
+pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads every
+view where the body is about as large (``auto_scale``, ``core.scales``).
 """
 
 from __future__ import annotations
@@ -89,6 +90,14 @@ class PointSet:
     weight: np.ndarray  # (N,) rim weight times the set's weight
     lengths: tuple[int, ...] = ()  # points per frame, when several frames are joined
 
+    def key_points(self) -> np.ndarray:
+        """(N,) which points are the key frame's: those after the first frame's when the
+        previous frame's and the key frame's points are joined (none otherwise)."""
+        out = np.zeros(len(self.value), bool)
+        if len(self.lengths) > 1:
+            out[self.lengths[0]:] = True
+        return out
+
     @staticmethod
     def joined(sets: list[PointSet]) -> PointSet:
         """One set of the points of ``sets`` (all of one view), in order."""
@@ -111,6 +120,13 @@ class _Samples:
     shape_cost: float = 0.0  # the silhouette term's cost
     shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
 
+
+
+def _clearly_lower(new: np.ndarray, old: np.ndarray) -> bool:
+    """Whether paired costs ``new`` are clearly lower than ``old``: the mean of their
+    differences over twice its standard error."""
+    d = old - new
+    return bool(d.mean() > 2 * d.std() / np.sqrt(len(d)))
 
 
 class FrameFit:
@@ -222,12 +238,15 @@ class FrameFit:
                    sets: list[PointSet], levels: list, level: int) -> BodyPose:
         """``est`` with the turns of ``searched`` that the pixels bear out: a limb's turn is
         kept only when, in every view that sees the limb, its pixels of the earlier frames
-        match the new image clearly better turned than not (the mean of their costs'
-        differences over twice its standard error); else the limb keeps its predicted
-        motion. The silhouette proposes, brightness decides: an outline alone also fits
-        shadows, clutter and the gaps between other limbs. A limb no view's earlier pixels
-        show (it was hidden) has only its outline to go by, and the search's own test
-        stands."""
+        match the new image clearly better turned than not (``_clearly_lower``); else the
+        limb keeps its predicted motion. The silhouette proposes, brightness decides: an
+        outline alone also fits shadows, clutter and the gaps between other limbs. Where
+        two or more views see the limb, a view may bear the turn out by the key frame's
+        pixels alone: the earlier frame's pixels of a limb that was already off are what it
+        wrongly covered, and they hold it there; the key frame's are the user's pose. One
+        view's key pixels alone are not enough (a limb's shading changes as it turns under
+        a hard light). A limb no view's earlier pixels show (it was hidden) has only its
+        outline to go by, and the search's own test stands."""
         kin = Kinematics(self.skeleton, est)
         base = self.sample(est, kin, sets, levels, level)
         moved = self.skeleton.moved_by()
@@ -241,7 +260,7 @@ class FrameFit:
                 cand.rotations[j] = searched.rotations[j]
             trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
                                 base.sigmas)
-            seen = clear = 0
+            seen = clear = vouched = 0
             for c, ps in enumerate(sets):
                 on = moved[ps.seg_joint, limb.joint]
                 old, new = (x[bounds[c]:bounds[c + 1]][on] for x in (base.costs, trial.costs))
@@ -249,9 +268,12 @@ class FrameFit:
                 if both.sum() < MIN_LIMB_POINTS:
                     continue  # this view does not see the limb (hidden, or too small)
                 seen += 1
-                d = old[both] - new[both]
-                clear += d.mean() > 2 * d.std() / np.sqrt(len(d))
-            if clear == seen:  # no view's pixels see it (hidden before): the outline decides
+                earlier = _clearly_lower(new[both], old[both])
+                key = both & ps.key_points()[on]
+                clear += earlier
+                vouched += earlier or (key.sum() >= MIN_LIMB_POINTS
+                                       and _clearly_lower(new[key], old[key]))
+            if clear == seen or (seen > 1 and vouched == seen):
                 out = cand
         return out
 

@@ -475,3 +475,31 @@ def test_a_joined_point_set_keeps_each_frames_noise_scale(body):
     joined = tracker.sample(pose, kin, [PointSet.joined([prev, key])], levels, 0).sigmas[0]
     np.testing.assert_array_equal(joined, np.concatenate(apart))
     assert apart[0][0] > 2 * apart[1][0]  # the noisy frame's scale is its own
+
+
+
+def _swung(sk, pose: BodyPose, name: str, degrees: float, axis: int) -> BodyPose:
+    """``pose`` with the ball joint ``name`` swung ``degrees`` about its bone frame's
+    ``axis`` (1 or 2: across its bone)."""
+    out = pose.copy()
+    j = sk.index(name)
+    out.rotations[j] = out.rotations[j] @ se3.exp_so3(sk.bone_frame(j)[axis] * np.radians(degrees))
+    return out
+
+
+@pytest.mark.parametrize("joint, held, off, axis", [("RightShoulder", -60, 50, 1),
+                                                    ("RightHip", -40, 45, 2)])
+def test_a_lost_limb_is_turned_back_where_the_key_frames_pixels_bear_it_out_in_every_view(
+        body, joint, held, off, axis):
+    """The body holds a limb out and stands still; on the last tracked frame that limb was
+    left far off. Its pixels of that frame are the backdrop and what it wrongly covered: they
+    match the new frame best where it stays (with their word alone, the limb stayed 45-50
+    degrees off). The key frame's pixels are the limb's own, and in each of the three views
+    they match the new frame clearly better with the limb turned back onto the silhouette."""
+    sk, rest = body
+    pose = _swung(sk, rest, joint, held, axis)
+    lost = _swung(sk, pose, joint, off, axis)
+    assert _limb_errors(sk, lost, pose).max() > 40
+    frames = [[render(sk, pose, c, noise=0.01, seed=i) for i in range(3)] for c in range(3)]
+    res = Tracker(sk, frames, CALIBRATED).track_frame(lost, 1, pose, 0, lost, 2)
+    assert _limb_errors(sk, res.pose, pose).max() < 2.0
