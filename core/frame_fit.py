@@ -251,6 +251,7 @@ class FrameFit:
         base = self.sample(est, kin, sets, levels, level)
         moved = self.skeleton.moved_by()
         bounds = np.cumsum([0] + [len(ps.value) for ps in sets])
+        keys = [ps.key_points() for ps in sets]
         out = est
         for limb in self._search.limbs:
             if self.skeleton.names[limb.joint] not in turned:
@@ -268,11 +269,13 @@ class FrameFit:
                 if both.sum() < MIN_LIMB_POINTS:
                     continue  # this view does not see the limb (hidden, or too small)
                 seen += 1
-                earlier = _clearly_lower(new[both], old[both])
-                key = both & ps.key_points()[on]
-                clear += earlier
-                vouched += earlier or (key.sum() >= MIN_LIMB_POINTS
-                                       and _clearly_lower(new[key], old[key]))
+                if _clearly_lower(new[both], old[both]):
+                    clear += 1
+                    vouched += 1
+                    continue
+                key = both & keys[c][on]
+                vouched += bool(key.sum() >= MIN_LIMB_POINTS
+                                and _clearly_lower(new[key], old[key]))
             if clear == seen or (seen > 1 and vouched == seen):
                 out = cand
         return out
