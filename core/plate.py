@@ -34,6 +34,8 @@ GUTTER_DIP = 0.65  # a line this much darker than the lightest beside it is a th
 GUTTER_REACH = 6  # pixels either side a thin gutter is compared with
 MIN_CELL_SHARE = 0.4  # a run narrower than this share of the widest is a strip, not a cell
 BORDER = 1  # pixels trimmed off each cell's edges (the gutter's blurred rim)
+FEET_TOLERANCE = 2  # pixels an animal's lowest row may differ from the first cell's and
+# still stand on the same ground (hooves and paws lift a little as they step)
 
 
 class PlateError(InputError):
@@ -131,9 +133,9 @@ def _row_profile(cell: np.ndarray) -> np.ndarray:
     return p - np.convolve(np.pad(p, k // 2, mode="edge"), np.ones(k) / k, mode="valid")
 
 
-def _shift(ref: np.ndarray, cur: np.ndarray, most: int) -> float:
-    """The shift d (within +-``most``) with cur[i + d] best matching ref[i] (normalised
-    correlation over the overlap), to a fraction of a sample (a parabola through the peak)."""
+def _match_scores(ref: np.ndarray, cur: np.ndarray, most: int) -> np.ndarray:
+    """Normalised correlation of ref[i] with cur[i + d] over their overlap, for every shift
+    d in -``most``..``most`` (index d + most)."""
     scores = []
     for d in range(-most, most + 1):
         a = ref[max(0, -d):len(ref) - max(0, d)]
@@ -142,8 +144,21 @@ def _shift(ref: np.ndarray, cur: np.ndarray, most: int) -> float:
         a, b = a[:n] - a[:n].mean(), b[:n] - b[:n].mean()
         den = np.sqrt(np.sum(a * a) * np.sum(b * b))
         scores.append(np.sum(a * b) / den if den > 0 else -1.0)
-    scores = np.array(scores)
+    return np.array(scores)
+
+
+def _shift(scores: np.ndarray, most: int, near: float | None = None) -> float:
+    """The shift d with the best score (``_match_scores``), to a fraction of a sample (a
+    parabola through the peak); with ``near``, the best of the peaks (local maxima scoring
+    over 0) within ``FEET_TOLERANCE`` of it, where there is one."""
     i = int(np.argmax(scores))
+    if near is not None:
+        peaks = [k for k in range(len(scores)) if scores[k] > 0
+                 and abs(k - most - near) <= FEET_TOLERANCE
+                 and (k == 0 or scores[k] >= scores[k - 1])
+                 and (k == len(scores) - 1 or scores[k] >= scores[k + 1])]
+        if peaks:
+            i = max(peaks, key=lambda k: scores[k])
     frac = 0.0
     if 0 < i < len(scores) - 1:
         c = scores[i - 1] - 2 * scores[i] + scores[i + 1]
@@ -151,21 +166,41 @@ def _shift(ref: np.ndarray, cur: np.ndarray, most: int) -> float:
     return i - most + frac
 
 
+def _lowest(cell: np.ndarray) -> float | None:
+    """The lowest row of the animal in a cell (grey): of the largest dark shape that
+    ``backdrop_mask`` leaves out, the row above its lowest half percent of pixels (a stray
+    dark pixel of the print does not lower it); None when the cell shows none."""
+    body = (~backdrop_mask(cell)).astype(np.uint8)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(body)
+    if n < 2:
+        return None
+    largest = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return float(np.percentile(np.nonzero(labels == largest)[0], 99.5))
+
+
 def register(reference: np.ndarray, cell: np.ndarray) -> np.ndarray:
     """Offset (2,) of ``cell`` against ``reference`` (grey cells, any sizes): the cell's
     pixel at ``p + offset`` shows what the reference shows at p (``_offset``)."""
-    return _offset(_row_profile(reference), cell)
+    return _offset(_row_profile(reference), _lowest(reference), cell)
 
 
-def _offset(reference_rows: np.ndarray, cell: np.ndarray) -> np.ndarray:
-    """``register`` against a reference cell's ``_row_profile``. Down: from the backdrop's
-    rows (the ground's edge, the measuring grid's lines), searched within a tenth of the
-    cell's height, as crops differ by a few pixels. Across: none. The cameras stood side
-    by side, so each cell shows another stretch of the grid, and its columns repeat: on
-    the three plates tried, matching them jumped 6 to 15 pixels between neighbouring
-    cells, a grid square's width, not the crop's error."""
+def _offset(reference_rows: np.ndarray, reference_feet: float | None, cell: np.ndarray
+            ) -> np.ndarray:
+    """``register`` against a reference cell's ``_row_profile`` and its animal's lowest row.
+    Down: from the backdrop's rows (the ground's edge, the measuring grid's lines), searched
+    within a tenth of the cell's height, as crops differ by a few pixels. The grid's lines
+    repeat, so the profile also matches a grid square off; of its matches, the best that
+    keeps the animal's feet on the reference's ground (its lowest row within
+    ``FEET_TOLERANCE``) is taken, and the best overall where none does (an animal leaping
+    or rearing). Across: none. The cameras stood side by side, so each cell shows another
+    stretch of the grid, and its columns repeat: on the three plates tried, matching them
+    jumped 6 to 15 pixels between neighbouring cells, a grid square's width, not the
+    crop's error."""
     most = max(2, len(reference_rows) // 10)
-    return np.array([0.0, _shift(reference_rows, _row_profile(cell), most)])
+    scores = _match_scores(reference_rows, _row_profile(cell), most)
+    feet = _lowest(cell)
+    near = None if feet is None or reference_feet is None else feet - reference_feet
+    return np.array([0.0, _shift(scores, most, near)])
 
 
 def import_plate(grey: np.ndarray, per_row: int | None = None
@@ -175,10 +210,10 @@ def import_plate(grey: np.ndarray, per_row: int | None = None
     boxes = find_cells(grey, per_row)
     crops = [grey[y0:y1, x0:x1] for x0, y0, x1, y1 in boxes]
     first = crops[0]
-    first_rows = _row_profile(first)  # each cell is matched against it
+    first_rows, first_feet = _row_profile(first), _lowest(first)  # each cell's reference
     cells, frames = [], []
     for box, crop in zip(boxes, crops):
-        offset = np.zeros(2) if crop is first else _offset(first_rows, crop)
+        offset = np.zeros(2) if crop is first else _offset(first_rows, first_feet, crop)
         cells.append(Cell(box, offset))
         warp = np.array([[1, 0, offset[0]], [0, 1, offset[1]]], np.float32)
         frames.append(cv2.warpAffine(crop.astype(np.float32), warp,

@@ -32,18 +32,37 @@ def test_the_silhouette_is_the_largest_dark_piece_on_a_light_backdrop():
     assert sil.sum() == 20 * 40 and sil[30, 30] and not sil[6, 61] and not sil[50, 70]
 
 
-def test_the_baboon_tracked_overlaps_its_outline_better_than_its_first_pose_carried():
-    """Measured with the committed clicks: every tracked frame 0.55-0.68 against 0.58 on
-    the first, the first pose carried along 0.41-0.57. Clicks moved by 1.5 pixels (five
-    draws) keep the tracked mean above the carried one by 0.03-0.09, but the worst frame
-    falls to 0.24-0.80 of the first's and two of the five stop at a diverged frame: so
-    beyond the committed clicks' run going through, only what held for all of them is
-    asserted."""
-    scores = plates.run("baboon")
-    assert len(scores) == 12 and not any(s.diverged for s in scores)
-    later = scores[1:]
-    assert np.mean([s.tracked for s in later]) > np.mean([s.carried for s in later]) + 0.02
-    assert scores[0].tracked > 0.5  # the clicked pose does line up
+def test_the_baboon_tracked_overlaps_its_outline_on_every_frame_as_on_the_first():
+    """Measured over eight runs (the committed clicks, and seven draws of them nudged by up
+    to a pixel): every run tracks all twelve frames, its worst frame's overlap 0.90-0.97 of
+    the first's, the tracked mean 0.58-0.61 against 0.50-0.53 for the first pose carried
+    along. Three of those runs, with a margin on the worst frame."""
+    for draw in range(3):
+        scores = plates.run("baboon", draw)
+        assert len(scores) == 12 and not any(s.diverged for s in scores), draw
+        later = scores[1:]
+        assert min(s.tracked for s in later) > 0.85 * scores[0].tracked, draw
+        assert np.mean([s.tracked for s in later]) > np.mean([s.carried for s in later]) + 0.03
+        assert scores[0].tracked > 0.5  # the clicked pose does line up
+
+
+def test_nudged_clicks_move_each_joint_by_a_pixel_at_most_and_none_for_draw_0():
+    spec = json.loads((plates.DATA / "baboon.json").read_text())
+    assert plates.nudged(spec, 0) is spec
+    moved = plates.nudged(spec, 5)
+    d = np.array([np.subtract(moved["clicks"][n], xy) for n, xy in spec["clicks"].items()])
+    assert np.abs(d).max() == 1 and np.any(d != 0) and moved["scored"] == spec["scored"]
+
+
+def test_clicks_scored_on_an_earlier_cut_follow_the_cells_to_the_new_one():
+    spec = {"scored_cut": [0.0, 4.0], "scored": {
+        "1": {"snout": [10, 20], "fore": [[5, 30]], "hind": []},
+        "2": {"snout": [11, 21], "fore": [[6, 31], [7, 32]], "hind": [[1, 33]]}}}
+    # cell 2 now moved 2 rows up where it was moved 4 down: its clicks 6 rows lower
+    moved = plates.clicks_on_cut(spec, [0.0, -2.0])
+    assert moved["scored"]["1"] == {"snout": [10, 20], "fore": [[5, 30]], "hind": []}
+    assert moved["scored"]["2"] == {"snout": [11, 27], "fore": [[6, 37], [7, 38]],
+                                    "hind": [[1, 39]]}
 
 
 def test_clicked_feet_are_matched_to_the_nearer_of_their_pair():

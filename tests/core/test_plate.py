@@ -1,6 +1,8 @@
 """Plate import: cells found and lined up on a synthetic plate whose cells and offsets are
-known, and on three printed Muybridge plates, where the ground line is the check."""
+known, and on three printed Muybridge plates, where the ground line and the feet clicked by
+hand are the check."""
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -26,10 +28,13 @@ def _scene(width=900, height=160, seed=0):
     return np.clip(img + rng.normal(0, 0.02, img.shape), 0, 1)
 
 
-def _animal(cell, x):
-    cv2.ellipse(cell, (x, 55), (30, 14), 0, 0, 360, 0.15, -1)
+def _animal(cell, x, top):
+    """An animal standing on the scene's ground (row 110) in a cell cropped from scene row
+    ``top``."""
+    y = 88 - top
+    cv2.ellipse(cell, (x, y), (30, 12), 0, 0, 360, 0.15, -1)
     for dx in (-20, 15):  # legs
-        cv2.line(cell, (x + dx, 60), (x + dx + 3, 95), 0.15, 4)
+        cv2.line(cell, (x + dx, y + 5), (x + dx + 3, 109 - top), 0.15, 4)
 
 
 def _plate(tops, widths, gutters, per_row, height=80):
@@ -43,7 +48,7 @@ def _plate(tops, widths, gutters, per_row, height=80):
         x = 8
         for k in row:
             cell = scene[tops[k]:tops[k] + height, 40 * k:40 * k + widths[k]].copy()
-            _animal(cell, 50 + 3 * k)
+            _animal(cell, 50 + 3 * k, tops[k])
             plate[y:y + height, x:x + widths[k]] = cell
             boxes.append((x, y, x + widths[k], y + height))
             x += widths[k] + gutters[k]
@@ -92,17 +97,39 @@ def _ground(frame):
     return low + int(np.argmin(steps[low:-2]))
 
 
-@pytest.mark.parametrize("name, n_cells", [("baboon", 12), ("camel", 10), ("mule", 8)])
-def test_printed_plates_give_their_cells_with_the_ground_lined_up(name, n_cells):
+def _printed(name, n_cells):
+    """A printed plate's grey image and its cells (as many as printed, of one size)."""
     with quiet_stderr():
         grey = load_grey(PLATES / f"plate_{name}.png")
     cells, frames = import_plate(grey)
     assert len(cells) == n_cells
     widths = [c.box[2] - c.box[0] for c in cells]
     assert max(widths) < 1.1 * min(widths)  # cells of one size, as printed
+    return grey, cells, frames
+
+
+@pytest.mark.parametrize("name, n_cells", [("camel", 10), ("mule", 8)])
+def test_printed_plates_give_their_cells_with_the_ground_line_lined_up(name, n_cells):
+    grey, cells, frames = _printed(name, n_cells)
     raw = [grey[y0:y1, x0:x1] for x0, y0, x1, y1 in (c.box for c in cells)]
     near = [sum(abs(_ground(f) - _ground(fs[0])) <= 1 for f in fs[1:]) for fs in (raw, frames)]
     assert near[1] > near[0] and near[1] >= 0.6 * (n_cells - 1), near
+
+
+@pytest.mark.parametrize("name, n_cells", [("baboon", 12), ("camel", 10)])
+def test_printed_plates_stand_the_clicked_feet_on_one_ground(name, n_cells):
+    """The feet clicked by hand on every frame (``bench/data/plates``; a walker and a
+    galloper always have one down, near enough) stand on one ground: the lowest clicked
+    foot of each frame within 3 pixels of their median over the frames. The baboon's
+    floor shows no ground line, and its measuring grid matches itself a square off."""
+    _, cells, _ = _printed(name, n_cells)
+    spec = json.loads((ROOT / "bench" / "data" / "plates" / f"{name}.json").read_text())
+    lowest = []
+    for k, cell in enumerate(cells):
+        clicked = spec["scored"][str(k + 1)]
+        feet = max(y for _, y in clicked["fore"] + clicked["hind"])  # clicked on the old cut
+        lowest.append(feet + spec["scored_cut"][k] - cell.offset[1])
+    assert np.abs(np.array(lowest) - np.median(lowest)).max() <= 3, np.round(lowest, 1)
 
 
 def test_register_finds_a_known_shift_to_a_fraction_of_a_pixel():
