@@ -12,10 +12,11 @@ the column profile's autocorrelation), or as many as the caller says.
 Muybridge's cameras stood in a row at equal spacing, each behind its own cell, so the
 scene behind the animal -- the ground line, the measuring grid's rows -- stands at one
 height in every cell but for where the crop fell. Each cell is moved up or down onto the
-first by that backdrop alone (``register``; OpenCV's ECC over the backdrop's pixels did
-not converge on most cells of the three plates tried). The frames are the cells resampled
-onto the first cell's pixels. Pixels: x right, y down, origin at the plate's top-left
-pixel; boxes are (x0, y0, x1, y1), ends exclusive.
+first by that backdrop (``register``; OpenCV's ECC over the backdrop's pixels did not
+converge on most cells of the three plates tried); where the grid's repeating rows match
+in more than one place, the animal's feet on the first cell's ground choose. The frames
+are the cells resampled onto the first cell's pixels. Pixels: x right, y down, origin at
+the plate's top-left pixel; boxes are (x0, y0, x1, y1), ends exclusive.
 """
 
 from __future__ import annotations
