@@ -1,5 +1,7 @@
-"""The suite's captures of other namings and its cameras, against what each file says."""
+"""The suite's captures of other namings, its cameras and its jobs from later starting frames,
+against what each file says; its scores over several starts."""
 
+import json
 import sys
 from pathlib import Path
 
@@ -165,3 +167,41 @@ def test_a_panning_cameras_backdrop_turns_with_it_as_any_still_scene_would():
             seen += 1
     assert seen >= 2
     assert abs(turned[180, 240] - back[180, 240]).max() > 0  # it did turn
+
+
+def test_a_run_from_a_later_frame_is_posed_there_and_takes_every_step_th_frame_from_it(
+        tmp_path):
+    """``write_job``'s starting frame: the capture's pose there, the run's frames from it
+    on, and a moving camera's poses on those same frames."""
+    from suite import CLIPS, write_job
+    from suite_footage import LOOKS, look_cameras, stage
+
+    clip_dir = tmp_path / "clip"
+    stage(CLIPS[0], clip_dir)
+    n = len(read_bvh(clip_dir / "truth.bvh").poses()[0])
+    first = json.loads(write_job(clip_dir, "panning", "1 lateral view 15 fps", {}).read_text())
+    later = write_job(clip_dir, "panning", "1 lateral view 15 fps", {}, start=3)
+    assert later.name.endswith("__from_3.json")
+    job = json.loads(later.read_text())
+    assert first["initial"]["frame"] == 0 and job["initial"]["frame"] == 3
+    frames = [int(Path(p).stem) for p in job["views"][0]["images"]]
+    assert frames == list(range(3, n, 2))
+    full = look_cameras(clip_dir, LOOKS["panning"])["lateral"]
+    np.testing.assert_allclose(job["views"][0]["camera"]["R"], np.array(full["R"])[3::2])
+    np.testing.assert_allclose(job["views"][0]["camera"]["t"], np.array(full["t"])[3::2])
+
+
+def test_runs_from_several_starts_are_scored_by_their_mean_and_summed_counts():
+    from suite import over_starts
+
+    runs = [{"tracker": t, "still": 30.0 + t, "best": 1.0, "tracked": k, "of": 30,
+             "diverged": k < 30, "fps": f, "peak_mb": m, "flags": (1, 2, 3)}
+            for t, k, f, m in ((10.0, 30, 5.0, 100), (14.0, 22, 6.0, 120), (12.0, 29, 4.0, 90))]
+    row = over_starts(runs)
+    assert (row["tracker"], row["low"], row["high"]) == (12.0, 10.0, 14.0)
+    assert row["still"] == 42.0 and row["best"] == 1.0
+    assert (row["tracked"], row["of"], row["stopped"], row["starts"]) == (81, 90, 2, 3)
+    assert row["fps"] == 5.0 and row["peak_mb"] == 120 and row["flags"] == (3, 6, 9)
+    assert "image_pct" not in row
+    runs[0]["image_pct"], runs[1]["image_pct"], runs[2]["image_pct"] = 1.0, 2.0, 6.0
+    assert over_starts(runs)["image_pct"] == 3.0
