@@ -32,7 +32,7 @@ from .confidence import frame_list
 from .errors import InputError
 from .init_fit import FitError, fit_pose, least_certain
 from .job import JobError, load_fit, load_job
-from .plate import write_frames
+from .plate import unconfirmed, write_frames
 from .pose import world_pose
 from .run import report, result_bvh, timed_run, write_report
 from .tracker import TrackResult
@@ -143,6 +143,9 @@ def _plate(args) -> int:
           f"{args.out}; each cell's offset down from the first's: "
           f"{', '.join(f'{c.offset[1]:+.1f}' for c in cells)} px",
           file=sys.stderr)
+    doubtful = unconfirmed(cells)
+    if doubtful:
+        print(f"note: {doubtful}", file=sys.stderr)
     return 0
 
 

@@ -47,6 +47,8 @@ class PlateError(InputError):
 class Cell:
     box: tuple[int, int, int, int]  # (x0, y0, x1, y1) in the plate
     offset: np.ndarray  # (2,) where the first cell's pixel (0, 0) falls in this cell
+    off_feet: bool = False  # the offset puts the animal's lowest point off the first cell's
+    # ground: the backdrop alone lined it up
 
 
 def _runs(keep: np.ndarray) -> list[tuple[int, int]]:
@@ -148,45 +150,49 @@ def _match_scores(ref: np.ndarray, cur: np.ndarray, most: int) -> np.ndarray:
     return np.array(scores)
 
 
-def _shift(scores: np.ndarray, most: int, near: float | None = None) -> float:
+def _shift(scores: np.ndarray, most: int, near: float | None = None) -> tuple[float, bool]:
     """The shift d with the best score (``_match_scores``), to a fraction of a sample (a
     parabola through the peak); with ``near``, the best of the peaks (local maxima scoring
-    over 0) within ``FEET_TOLERANCE`` of it, where there is one."""
+    over 0) within ``FEET_TOLERANCE`` of it, where there is one. And whether ``near`` was
+    given and no peak was near it (the best overall taken instead)."""
     i = int(np.argmax(scores))
-    if near is not None:
-        peaks = [k for k in range(len(scores)) if scores[k] > 0
-                 and abs(k - most - near) <= FEET_TOLERANCE
-                 and (k == 0 or scores[k] >= scores[k - 1])
-                 and (k == len(scores) - 1 or scores[k] >= scores[k + 1])]
-        if peaks:
-            i = max(peaks, key=lambda k: scores[k])
+    peaks = [] if near is None else [
+        k for k in range(len(scores)) if scores[k] > 0 and abs(k - most - near) <= FEET_TOLERANCE
+        and (k == 0 or scores[k] >= scores[k - 1])
+        and (k == len(scores) - 1 or scores[k] >= scores[k + 1])]
+    if peaks:
+        i = max(peaks, key=lambda k: scores[k])
     frac = 0.0
     if 0 < i < len(scores) - 1:
         c = scores[i - 1] - 2 * scores[i] + scores[i + 1]
         frac = 0.5 * (scores[i - 1] - scores[i + 1]) / c if c < 0 else 0.0
-    return i - most + frac
+    return i - most + frac, near is not None and not peaks
 
 
 def _lowest(cell: np.ndarray) -> float | None:
     """The lowest row of the animal in a cell (grey): of the largest dark shape that
     ``backdrop_mask`` leaves out, the row above its lowest half percent of pixels (a stray
-    dark pixel of the print does not lower it); None when the cell shows none."""
+    dark pixel of the print does not lower it). None when the cell shows none, or when that
+    shape reaches the cell's bottom row: cut off by the crop, or run into a dark ground,
+    its lowest row is not where the feet stand."""
     body = (~backdrop_mask(cell)).astype(np.uint8)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(body)
     if n < 2:
         return None
     largest = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    if np.any(labels[-1] == largest):
+        return None
     return float(np.percentile(np.nonzero(labels == largest)[0], 99.5))
 
 
 def register(reference: np.ndarray, cell: np.ndarray) -> np.ndarray:
     """Offset (2,) of ``cell`` against ``reference`` (grey cells, any sizes): the cell's
     pixel at ``p + offset`` shows what the reference shows at p (``_offset``)."""
-    return _offset(_row_profile(reference), _lowest(reference), cell)
+    return _offset(_row_profile(reference), _lowest(reference), cell)[0]
 
 
 def _offset(reference_rows: np.ndarray, reference_feet: float | None, cell: np.ndarray
-            ) -> np.ndarray:
+            ) -> tuple[np.ndarray, bool]:
     """``register`` against a reference cell's ``_row_profile`` and its animal's lowest row.
     Down: from the backdrop's rows (the ground's edge, the measuring grid's lines), searched
     within a tenth of the cell's height, as crops differ by a few pixels. The grid's lines
@@ -196,12 +202,13 @@ def _offset(reference_rows: np.ndarray, reference_feet: float | None, cell: np.n
     or rearing). Across: none. The cameras stood side by side, so each cell shows another
     stretch of the grid, and its columns repeat: on the three plates tried, matching them
     jumped 6 to 15 pixels between neighbouring cells, a grid square's width, not the
-    crop's error."""
+    crop's error. Also whether the feet were found off every match (``Cell.off_feet``)."""
     most = max(2, len(reference_rows) // 10)
     scores = _match_scores(reference_rows, _row_profile(cell), most)
     feet = _lowest(cell)
     near = None if feet is None or reference_feet is None else feet - reference_feet
-    return np.array([0.0, _shift(scores, most, near)])
+    down, off_feet = _shift(scores, most, near)
+    return np.array([0.0, down]), off_feet
 
 
 def import_plate(grey: np.ndarray, per_row: int | None = None
@@ -214,14 +221,30 @@ def import_plate(grey: np.ndarray, per_row: int | None = None
     first_rows, first_feet = _row_profile(first), _lowest(first)  # each cell's reference
     cells, frames = [], []
     for box, crop in zip(boxes, crops):
-        offset = np.zeros(2) if crop is first else _offset(first_rows, first_feet, crop)
-        cells.append(Cell(box, offset))
+        offset, off_feet = (np.zeros(2), False) if crop is first else _offset(
+            first_rows, first_feet, crop)
+        cells.append(Cell(box, offset, off_feet))
         warp = np.array([[1, 0, offset[0]], [0, 1, offset[1]]], np.float32)
         frames.append(cv2.warpAffine(crop.astype(np.float32), warp,
                                      (first.shape[1], first.shape[0]),
                                      flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
                                      borderMode=cv2.BORDER_REPLICATE))
     return cells, frames
+
+
+def unconfirmed(cells: list[Cell]) -> str:
+    """The cells (1-based, in reading order) whose animal's feet no match of the backdrop
+    stood on the first cell's ground, as advice to look at them ('' when there are none):
+    their backdrop alone lined them up, and the measuring grid may have matched a square
+    off."""
+    doubtful = [str(k) for k, c in enumerate(cells, 1) if c.off_feet]
+    if not doubtful:
+        return ""
+    return (f"cell{'s' if len(doubtful) > 1 else ''} {', '.join(doubtful)} lined up by the "
+            "backdrop alone (the animal's lowest point not on the first cell's ground: in "
+            "the air, rearing, or legs too thin to make out): check that "
+            f"{'they are' if len(doubtful) > 1 else 'it is'} not a grid square too high or "
+            "low")
 
 
 def write_frames(plate: str | Path, out: str | Path, per_row: int | None = None

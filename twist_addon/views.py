@@ -16,7 +16,7 @@ from ..core.calibration import read_calibration
 from ..core.errors import InputError
 from ..core.image import IMAGE_SUFFIXES
 from ..core.lens import Undistorted
-from ..core.plate import write_frames
+from ..core.plate import unconfirmed, write_frames
 from ..core.video import VideoFrames, is_video
 from .bridge import BridgeError, place_pinhole
 from .clip_lens import undistorted
@@ -192,6 +192,9 @@ class TWIST_OT_add_plate_view(_FromFile, bpy.types.Operator):
         except InputError as e:
             raise BridgeError(f"{plate.name}: {e}") from None
         message = add_footage_view(context, paths[0], self.first_frame)
+        doubtful = unconfirmed(cells)
+        if doubtful:
+            self.report({"WARNING"}, f"{plate.name}: {doubtful}")
         return f"{plate.name}: {len(cells)} cells cut into {out.name}/; " + message
 
 
