@@ -137,11 +137,13 @@ class Tracker(FrameFit):
         ``held`` (limbs no view saw on the last frame) are predicted where they were: the
         footage did not show their motion."""
         pred = extrapolate(before, last, self.settings.prediction_gain)
-        for name in held:
-            j = self.skeleton.index(name)
+        held_joints = {self.skeleton.index(name) for name in held}
+        for j in held_joints:
             pred.rotations[j] = last.rotations[j]
         for k in self._limited:
             j, axis = self._dof_joint[k], self._dof_axis[k]
+            if j in held_joints:
+                continue
             step = se3.log_so3(before.rotations[j].T @ last.rotations[j]) @ axis
             lo, hi = self.skeleton.hinge_turns(j, last.rotations[j])
             turn = self.settings.prediction_gain * step

@@ -199,7 +199,7 @@ def test_the_prediction_holds_a_hinge_its_speed_would_carry_past_a_limit_and_an_
     """Knees limited to 0-150 degrees: one bending 40 degrees a frame from 100 to 140 is
     predicted at 140 (carried on, it would pass the limit, and past 180 wrap round to bend
     backward); one bending 20 from 60 carries on to 100, and a ball joint carries on too,
-    unless no view saw it."""
+    unless no view saw it (then, hinge or ball, it is held where it was)."""
     _, pose = body
     sk = human_template()  # a skeleton of its own: the test sets limits on it
     fast, slow, hip = sk.index("LeftKnee"), sk.index("RightKnee"), sk.index("LeftHip")
@@ -219,10 +219,13 @@ def test_the_prediction_holds_a_hinge_its_speed_would_carry_past_a_limit_and_an_
     assert np.degrees(sk.hinge_angle(slow, pred.rotations[slow])) == pytest.approx(100)
     np.testing.assert_allclose(pred.rotations[hip], posed(0, 0, 3.0).rotations[hip],
                                atol=1e-12)
-    # a limb no view saw on the last frame is held where it was, the others carry on
-    held = tracker.predict(posed(100, 60, 1.0), posed(140, 80, 2.0), held=["LeftHip"])
+    # a limb no view saw on the last frame is held where it was, the others carry on; a
+    # limited hinge too, its limits notwithstanding
+    held = tracker.predict(posed(100, 60, 1.0), posed(140, 80, 2.0), held=["LeftHip",
+                                                                           "RightKnee"])
     np.testing.assert_array_equal(held.rotations[hip], posed(140, 80, 2.0).rotations[hip])
-    np.testing.assert_array_equal(held.rotations[slow], pred.rotations[slow])
+    np.testing.assert_array_equal(held.rotations[slow], posed(140, 80, 2.0).rotations[slow])
+    np.testing.assert_array_equal(held.rotations[fast], pred.rotations[fast])
 
 
 def test_cancel_keeps_the_frames_already_tracked(body):
