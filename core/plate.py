@@ -124,11 +124,12 @@ def backdrop_mask(cell: np.ndarray) -> np.ndarray:
     return cv2.dilate(body, np.ones((7, 7), np.uint8)) == 0
 
 
-def _row_profile(cell: np.ndarray) -> np.ndarray:
-    """The median brightness of each row of the cell's backdrop, less its running mean: the
-    grid's lines and the ground's edge, with the animal and the light's slow falloff left
-    out (a row the animal covers whole reads as the median of the whole row)."""
-    masked = np.where(backdrop_mask(cell), cell, np.nan)
+def _row_profile(cell: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
+    """The median brightness of each row of the cell's backdrop (its ``backdrop_mask``),
+    less its running mean: the grid's lines and the ground's edge, with the animal and the
+    light's slow falloff left out (a row the animal covers whole reads as the median of the
+    whole row)."""
+    masked = np.where(backdrop, cell, np.nan)
     seen = ~np.all(np.isnan(masked), axis=1)
     p = np.median(cell, axis=1)
     p[seen] = np.nanmedian(masked[seen], axis=1)
@@ -169,13 +170,13 @@ def _shift(scores: np.ndarray, most: int, near: float | None = None) -> tuple[fl
     return i - most + frac, near is not None and not peaks
 
 
-def _lowest(cell: np.ndarray) -> float | None:
-    """The lowest row of the animal in a cell (grey): of the largest dark shape that
-    ``backdrop_mask`` leaves out, the row above its lowest half percent of pixels (a stray
+def _lowest(backdrop: np.ndarray) -> float | None:
+    """The lowest row of the animal in a cell, from its ``backdrop_mask``: of the largest
+    dark shape that the mask leaves out, the row above its lowest half percent of pixels (a stray
     dark pixel of the print does not lower it). None when the cell shows none, or when that
     shape reaches the cell's bottom row: cut off by the crop, or run into a dark ground,
     its lowest row is not where the feet stand."""
-    body = (~backdrop_mask(cell)).astype(np.uint8)
+    body = (~backdrop).astype(np.uint8)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(body)
     if n < 2:
         return None
@@ -188,7 +189,8 @@ def _lowest(cell: np.ndarray) -> float | None:
 def register(reference: np.ndarray, cell: np.ndarray) -> np.ndarray:
     """Offset (2,) of ``cell`` against ``reference`` (grey cells, any sizes): the cell's
     pixel at ``p + offset`` shows what the reference shows at p (``_offset``)."""
-    return _offset(_row_profile(reference), _lowest(reference), cell)[0]
+    backdrop = backdrop_mask(reference)
+    return _offset(_row_profile(reference, backdrop), _lowest(backdrop), cell)[0]
 
 
 def _offset(reference_rows: np.ndarray, reference_feet: float | None, cell: np.ndarray
@@ -204,8 +206,9 @@ def _offset(reference_rows: np.ndarray, reference_feet: float | None, cell: np.n
     jumped 6 to 15 pixels between neighbouring cells, a grid square's width, not the
     crop's error. Also whether the feet were found off every match (``Cell.off_feet``)."""
     most = max(2, len(reference_rows) // 10)
-    scores = _match_scores(reference_rows, _row_profile(cell), most)
-    feet = _lowest(cell)
+    backdrop = backdrop_mask(cell)
+    scores = _match_scores(reference_rows, _row_profile(cell, backdrop), most)
+    feet = _lowest(backdrop)
     near = None if feet is None or reference_feet is None else feet - reference_feet
     down, off_feet = _shift(scores, most, near)
     return np.array([0.0, down]), off_feet
@@ -218,7 +221,8 @@ def import_plate(grey: np.ndarray, per_row: int | None = None
     boxes = find_cells(grey, per_row)
     crops = [grey[y0:y1, x0:x1] for x0, y0, x1, y1 in boxes]
     first = crops[0]
-    first_rows, first_feet = _row_profile(first), _lowest(first)  # each cell's reference
+    backdrop = backdrop_mask(first)  # each cell's reference: its rows and its animal's feet
+    first_rows, first_feet = _row_profile(first, backdrop), _lowest(backdrop)
     cells, frames = [], []
     for box, crop in zip(boxes, crops):
         offset, off_feet = (np.zeros(2), False) if crop is first else _offset(
