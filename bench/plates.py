@@ -241,15 +241,14 @@ def _score(sk: Skeleton, fr: FrameResult, sil: np.ndarray, carried: BodyPose,
 
 def summary(runs: list[list[FrameScore]]) -> dict[str, list[float]]:
     """Per run (its frames' scores), beyond the first frame: frames tracked, the worst
-    frame's overlap over the first's, the mean overlap, and for clicked plates the clicked
-    points' mean and worst frame and the first pose carried along's mean."""
-    out = {"frames": [], "worst_overlap": [], "overlap": [], "clicks": [], "clicks_worst": [],
+    frame's overlap over the first's, and for clicked plates the clicked points' mean and
+    worst frame and the first pose carried along's mean."""
+    out = {"frames": [], "worst_overlap": [], "clicks": [], "clicks_worst": [],
            "clicks_carried": []}
     for scores in runs:
         later = scores[1:]
         out["frames"].append(len(scores))
         out["worst_overlap"].append(min(s.tracked for s in later) / scores[0].tracked)
-        out["overlap"].append(float(np.mean([s.tracked for s in later])))
         if not np.isnan(scores[0].clicks):
             out["clicks"].append(float(np.nanmean([s.clicks for s in later])))
             out["clicks_worst"].append(float(np.nanmax([s.clicks for s in later])))
