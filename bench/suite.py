@@ -249,7 +249,24 @@ def table(rows: dict, runs: list[str]) -> list[str]:
     return out
 
 
+def command_line(argv: list[str]) -> str:
+    """The command that wrote a results file, as its reader would type it: the Bandai Namco
+    folder, a path on the writer's machine, shown as FOLDER; an argument with spaces
+    quoted."""
+    shown, folder_next = [], False
+    for arg in argv:
+        if folder_next:
+            arg, folder_next = "FOLDER", False
+        elif arg == "--bandai-namco":
+            folder_next = True
+        elif arg.startswith("--bandai-namco="):
+            arg = "--bandai-namco=FOLDER"
+        shown.append(f'"{arg}"' if " " in arg else arg)
+    return " ".join(["bench/suite.py"] + shown)
+
+
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="the CMU clips at 15 fps only")
     ap.add_argument("--bandai-namco", type=Path, metavar="FOLDER",
@@ -303,8 +320,7 @@ def main(argv=None) -> int:
     if a.write:
         head = [
             "# Benchmark results", "",
-            f"Written by `make bench` (`bench/suite.py`) on {time.strftime('%Y-%m-%d')}"
-            f"{' with the settings ' + a.settings if settings else ''}. Each clip is two "
+            f"Written by `{command_line(argv)}` on {time.strftime('%Y-%m-%d')}. Each clip is two "
             "seconds of real motion capture rendered in each look and tracked with the "
             f"default settings and the default blobs, from each of its first {starts} "
             "frame(s) (posed there by the capture): tracking is chaotic, so *tracker* is the "

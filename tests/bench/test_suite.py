@@ -205,3 +205,18 @@ def test_runs_from_several_starts_are_scored_by_their_mean_and_summed_counts():
     assert "image_pct" not in row
     runs[0]["image_pct"], runs[1]["image_pct"], runs[2]["image_pct"] = 1.0, 2.0, 6.0
     assert over_starts(runs)["image_pct"] == 3.0
+
+
+def test_a_results_file_names_the_command_that_wrote_it_without_the_writers_folder():
+    """The header of a written results file is the command to run again: the Bandai Namco
+    folder (a path on the writer's machine, never stored) shows as FOLDER, and a clip list
+    with spaces stays one argument."""
+    from suite import command_line
+
+    argv = ["--bandai-namco", "/home/me/data/mocap", "--clips", "BN brisk walk,BN dance",
+            "--starts", "3", "--write", "docs/B.md"]
+    assert command_line(argv) == ('bench/suite.py --bandai-namco FOLDER --clips '
+                                  '"BN brisk walk,BN dance" --starts 3 --write docs/B.md')
+    assert command_line(["--bandai-namco=/x/y", "--quick"]) == \
+        "bench/suite.py --bandai-namco=FOLDER --quick"
+    assert command_line([]) == "bench/suite.py"
