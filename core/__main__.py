@@ -97,8 +97,9 @@ def _track(args) -> int:
     check = result.frames_to_check
     if check:
         print(f"check {len(check)} frames where a view disagrees with a limb (its pixels, or "
-              f"its bone off the silhouette) or no view sees it: {frame_list(check)} (the "
-              "report names the limbs)", file=sys.stderr)
+              f"its bone off the silhouette), no view sees it, or the body tracked side-on "
+              f"turned toward or away from the camera: {frame_list(check)} (the report names "
+              "the limbs)", file=sys.stderr)
     if result.diverged_frames:
         f = result.diverged_frames[0]
         print(f"stopped: frame {f} diverged ({result.frames[-1].reason}); correct the pose"

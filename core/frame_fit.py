@@ -41,6 +41,7 @@ from .scales import Scales
 from .search import LimbSearch
 from .sequence import ImageSequence
 from .settings import TrackerSettings
+from .side_on import BODY, OUT_OF_SIDE_ON_DEG, TURNED
 from .skeleton import HINGE, Skeleton
 from .solver import (
     NormalEquations,
@@ -68,11 +69,18 @@ class FrameResult:
     seconds: float = 0.0
     given: bool = False  # the user's pose (the initial one or a correction), not tracked
     limbs: dict[str, LimbCheck] = field(default_factory=dict)  # tracked frames: each limb's
+    turned: float | None = None  # side-on: degrees the body turned in depth since the key
 
     @property
     def flagged(self) -> dict[str, str]:
-        """The limbs to check on this frame and why (``LimbCheck.flag``)."""
-        return {name: c.flag for name, c in self.limbs.items() if c.flag}
+        """What to check on this frame and why: the limbs (``LimbCheck.flag``), and, tracked
+        side-on, the body (``side_on.BODY``) where it turned more than
+        ``OUT_OF_SIDE_ON_DEG`` toward or away from the camera (one view shows that only by
+        foreshortening, and the limbs' hinges then no longer turn in the image plane)."""
+        out = {name: c.flag for name, c in self.limbs.items() if c.flag}
+        if self.turned is not None and self.turned > OUT_OF_SIDE_ON_DEG:
+            out[BODY] = TURNED
+        return out
 
 
 

@@ -14,6 +14,10 @@ from .search import SIDE_ON
 from .skeleton import HINGE, Skeleton
 
 ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see no depth
+# how far the body may turn toward or away from the camera before the side-on hinges no
+# longer turn in the image plane: the angle the limb search allows a hinge axis off the view
+OUT_OF_SIDE_ON_DEG = float(np.degrees(np.arccos(SIDE_ON)))
+BODY, TURNED = "body", "turned"  # the flag of a frame whose body turned out of side-on
 
 
 def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
@@ -52,3 +56,13 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
                    skeleton.end_sites, limits=limits)
     out.blobs = skeleton.blobs
     return out
+
+
+def turned_from(key: BodyPose, pose: BodyPose) -> float:
+    """Degrees the body at ``pose`` has turned toward or away from the first view's camera
+    since ``key`` (0 for a turn about the line of sight, which the image shows; a body
+    turned half round is seen side-on again): the angle between the line of sight as the
+    root's frame sees it at the two poses, the turn's sign left out."""
+    def sight(p: BodyPose) -> np.ndarray:
+        return p.rotations[0].T @ p.views[0].orientation[2]
+    return float(np.degrees(np.arccos(np.clip(abs(sight(key) @ sight(pose)), 0.0, 1.0))))

@@ -28,7 +28,7 @@ from .frame_fit import FrameFit, FrameResult
 from .linearize import Kinematics
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, extrapolate
 from .settings import TrackerSettings
-from .side_on import depth_blind_joints, side_on_skeleton
+from .side_on import depth_blind_joints, side_on_skeleton, turned_from
 from .skeleton import Skeleton
 from .solver import DegenerateSystem
 
@@ -175,6 +175,7 @@ class Tracker(FrameFit):
         self._cue.reset()  # learned from it
         self.notes = []
         blind = depth_blind_joints(self.given_skeleton, initial)
+        side_on = bool(blind) and self.settings.side_on
         if self.settings.side_on:
             self._use(side_on_skeleton(self.given_skeleton, initial))
             if blind:
@@ -230,6 +231,8 @@ class Tracker(FrameFit):
                     )
             residuals.append(res.residual)
             if not res.diverged:
+                if side_on:
+                    res.turned = turned_from(key, res.pose)
                 self._learn_backdrops(res)
             self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
                                 for f in (key_frame, prev.frame, frame)})

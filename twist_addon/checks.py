@@ -7,13 +7,17 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from ..core.confidence import UNSEEN
+from ..core.side_on import TURNED
+
 PREFIX = "check: "
 MAX_NAME = 63  # characters Blender keeps of a marker's name
 
 
 def marker_name(flagged: dict[str, str]) -> str:
-    """'check: LeftElbow, LeftKnee unseen', cut to what a marker's name holds."""
-    text = PREFIX + ", ".join(f"{bone}{' unseen' * (why == 'unseen')}"
+    """'check: LeftElbow, LeftKnee unseen, body turned', cut to what a marker's name
+    holds."""
+    text = PREFIX + ", ".join(f"{bone}{f' {why}' * (why in (UNSEEN, TURNED))}"
                               for bone, why in flagged.items())
     return text if len(text) <= MAX_NAME else text[:MAX_NAME - 3] + "..."
 

@@ -109,8 +109,8 @@ class TWIST_PG_result(bpy.types.PropertyGroup):
         name="Diverged", description="Frames where the last run stopped, and why")
     frames_to_check: bpy.props.StringProperty(
         name="Frames to Check", description="Tracked frames where a view disagrees with a limb "
-        "(its pixels, or its bone off the silhouette) or no view sees it (marked on the "
-        "timeline)")
+        "(its pixels, or its bone off the silhouette), no view sees it, or the body tracked "
+        "side-on turned toward or away from the camera (marked on the timeline)")
     notes: bpy.props.StringProperty(
         name="Notes", description="What the tracker noted about the last run, one note a "
         "line (a view whose backdrop moves, joints one line of sight cannot see turn)")

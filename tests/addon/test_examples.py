@@ -60,6 +60,14 @@ def test_an_unposed_template_tracked_says_which_frames_to_check(bpy_module, regi
     assert result.frames_to_check == ""
 
 
+def test_a_check_marker_names_the_limbs_and_a_body_turned_out_of_side_on(registered):
+    """A marker reads the flagged limbs, with the flags that are not a limb's own doubt
+    spelled out: a limb no view sees, and a body turned toward or away from one camera."""
+    checks = registered.twist_addon.checks
+    flagged = {"LeftElbow": "unsure", "LeftKnee": "unseen", "body": "turned"}
+    assert checks.marker_name(flagged) == "check: LeftElbow, LeftKnee unseen, body turned"
+
+
 def test_a_plates_example_stands_on_its_clicks_and_tracks_through(bpy_module, registered):
     """The camel's scene: its armature's joints and tips project onto the markers clicked on
     the first frame (Fit Pose to Markers from the rest pose gives that pose back), and Track

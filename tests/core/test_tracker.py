@@ -11,10 +11,10 @@ from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
 from core.settings import TrackerSettings
-from core.side_on import depth_blind_joints, side_on_skeleton
+from core.side_on import BODY, TURNED, depth_blind_joints, side_on_skeleton, turned_from
 from core.skeleton import HINGE, human_template
 from core.tracker import Tracker, track
-from support.synthetic import render, side_view
+from support.synthetic import render, side_pinhole, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
 
@@ -406,6 +406,51 @@ def test_one_view_tracked_side_on_follows_the_limbs_in_the_image(body):
     assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 1.5  # measured 0.85
     assert len(res.notes) == 1 and res.notes[0].startswith("side-on: ")
     assert all(n in res.notes[0] for n in ["LeftShoulder", "RightHip", "Neck"])
+
+
+@pytest.mark.parametrize("camera", [side_view, side_pinhole])
+def test_the_turn_out_of_side_on_is_the_bodys_turn_in_depth_not_in_the_image(body, camera):
+    """``turned_from``: a turn of the root about the vertical (across the line of sight) by
+    an angle reads that angle, half round reads 0 (side-on again, from the other side),
+    and a turn about the line of sight (in the image) reads 0, through either camera."""
+    sk, pose = body
+    side = BodyPose(pose.rotations, pose.root_position, [camera(yaw_deg=90)])
+    sight = side.views[0].orientation[2]
+
+    def turned(axis, degrees: float) -> BodyPose:
+        p = side.copy()
+        turn = se3.exp_so3(np.radians(degrees) * np.asarray(axis, float))
+        p.rotations[0] = turn @ p.rotations[0]
+        return p
+
+    for degrees in (0.0, 10.0, 25.0, 60.0, 90.0):
+        assert turned_from(side, turned([0, 1, 0], degrees)) == pytest.approx(degrees, abs=1e-6)
+    assert turned_from(side, turned([0, 1, 0], 180.0)) == pytest.approx(0.0, abs=1e-6)
+    assert turned_from(side, turned(sight, 70.0)) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_body_tracked_side_on_that_turns_toward_the_camera_is_flagged(body):
+    """One view, the body turning 10 degrees a frame about the vertical: the tracker
+    follows it, each frame reports how far it turned, and the frames past 25 degrees (where
+    the side-on hinges no longer turn in the image plane) are to check, the body flagged."""
+    sk, pose = body
+    side = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=90)])
+    poses = []
+    for k in range(6):
+        p = side.copy()
+        p.rotations[0] = se3.exp_so3(np.radians([0.0, 10.0 * k, 0.0])) @ p.rotations[0]
+        poses.append(p)
+    frames = [[render(sk, p, 0) for p in poses]]
+    settings = TrackerSettings(side_on=True, iterations=10)
+    res = track(Tracker(sk, frames, CALIBRATED, settings), side, list(range(6)))
+    turned = [fr.turned for fr in res.frames[1:]]
+    assert turned == pytest.approx([10, 20, 30, 40, 50], abs=1.0)  # measured 0.3-0.6 short
+    assert [f for f, why in res.frames_to_check.items() if why.get(BODY) == TURNED] == [3, 4, 5]
+    assert res.frames[0].turned is None  # the user's pose
+    views = [[render(sk, pose, c)] * 2 for c in range(3)]
+    three = track(Tracker(sk, views, CALIBRATED, TrackerSettings(iterations=1)), pose, [0, 1])
+    assert not three.frames[1].diverged
+    assert three.frames[1].turned is None  # views that look different ways see the turn
 
 
 def test_one_view_keeps_the_root_where_it_was_along_its_line_of_sight(body):
