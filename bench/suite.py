@@ -54,6 +54,7 @@ from walk_benchmark import track_job  # noqa: E402
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
+from core.side_on import OUT_OF_SIDE_ON_DEG  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
 DATA = ROOT / "bench" / "data"
@@ -138,7 +139,8 @@ BAD_LIMB_DEG = 20.0  # a limb this far off the capture is one the flags should c
 def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, int, int]:
     """How the report's limb flags match the truth over the eight limbs and the tracked
     frames: (flagged and over ``BAD_LIMB_DEG`` off, over it, flagged). A limb's flag is its
-    segment's (the nearest joint above the limb's first joint that the report names)."""
+    segment's (the nearest joint above the limb's first joint that the report names), or
+    the frame's body turned out of side-on, which puts every limb there in doubt."""
     bad = flagged = caught = 0
     ve = evaluate.limb_vectors(sk, *est, limbs)
     vt = evaluate.limb_vectors(sk, *truth, limbs)
@@ -150,7 +152,8 @@ def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, in
             segment = next(sk.names[j] for j in sk.ancestors(sk.index(a))
                            if sk.names[j] in fr["limbs"])
             off = np.degrees(se3.angle_between_vectors(ve[label][f], vt[label][f]))
-            flag = bool(fr["limbs"][segment]["flag"])
+            flag = bool(fr["limbs"][segment]["flag"]) or (
+                fr.get("turned") or 0.0) > OUT_OF_SIDE_ON_DEG
             bad += off > BAD_LIMB_DEG
             flagged += flag
             caught += flag and off > BAD_LIMB_DEG

@@ -220,3 +220,26 @@ def test_a_results_file_names_the_command_that_wrote_it_without_the_writers_fold
     assert command_line(["--bandai-namco=/x/y", "--quick"]) == \
         "bench/suite.py --bandai-namco=FOLDER --quick"
     assert command_line([]) == "bench/suite.py"
+
+
+def test_a_frame_whose_body_turned_out_of_side_on_flags_every_limb_there():
+    """The suite's flag counts: a limb counts as flagged by its own flag, or by its frame's
+    body having turned past ``OUT_OF_SIDE_ON_DEG`` (the frame is one to check, every limb
+    in doubt); and as caught where it is also over ``BAD_LIMB_DEG`` off."""
+    from suite import BAD_LIMB_DEG, flag_counts
+
+    from core.side_on import OUT_OF_SIDE_ON_DEG
+
+    sk = skeleton_from_bvh(read_bvh(ROOT / "bench" / "data" / "cmu05_01_walk.bvh"))
+    limbs = Parts.of(sk.names).limbs()
+    rest = np.tile(np.eye(3), (2, sk.n_joints, 1, 1)), np.zeros((2, 3))
+    off = rest[0].copy()  # the left thigh (and the shank with it) turned on frame 1
+    off[1, sk.index(limbs[0][1])] = se3.exp_so3(np.radians([0.0, 0.0, BAD_LIMB_DEG + 30]))
+    frame = {"frame": 1, "limbs": {name: {"flag": ""} for name in sk.names}, "turned": None}
+    rep = {"frames": [{"frame": 0, "limbs": {}}, frame]}
+    caught, bad, flagged = flag_counts(rep, sk, (off, rest[1]), rest, limbs)
+    assert (caught, flagged) == (0, 0) and bad >= 1
+    frame["turned"] = OUT_OF_SIDE_ON_DEG + 1
+    assert flag_counts(rep, sk, (off, rest[1]), rest, limbs) == (bad, bad, 8)
+    frame["turned"] = OUT_OF_SIDE_ON_DEG - 1
+    assert flag_counts(rep, sk, (off, rest[1]), rest, limbs) == (0, bad, 0)
