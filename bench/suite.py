@@ -54,7 +54,7 @@ from walk_benchmark import track_job  # noqa: E402
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
-from core.side_on import OUT_OF_SIDE_ON_DEG  # noqa: E402
+from core.side_on import out_of_side_on  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
 DATA = ROOT / "bench" / "data"
@@ -152,8 +152,7 @@ def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, in
             segment = next(sk.names[j] for j in sk.ancestors(sk.index(a))
                            if sk.names[j] in fr["limbs"])
             off = np.degrees(se3.angle_between_vectors(ve[label][f], vt[label][f]))
-            flag = bool(fr["limbs"][segment]["flag"]) or (
-                fr.get("turned") or 0.0) > OUT_OF_SIDE_ON_DEG
+            flag = bool(fr["limbs"][segment]["flag"]) or out_of_side_on(fr.get("turned"))
             bad += off > BAD_LIMB_DEG
             flagged += flag
             caught += flag and off > BAD_LIMB_DEG

@@ -41,7 +41,7 @@ from .scales import Scales
 from .search import LimbSearch
 from .sequence import ImageSequence
 from .settings import TrackerSettings
-from .side_on import BODY, OUT_OF_SIDE_ON_DEG, TURNED
+from .side_on import BODY, TURNED, out_of_side_on
 from .skeleton import HINGE, Skeleton
 from .solver import (
     NormalEquations,
@@ -75,10 +75,10 @@ class FrameResult:
     def flagged(self) -> dict[str, str]:
         """What to check on this frame and why: the limbs (``LimbCheck.flag``), and, tracked
         side-on, the body (``side_on.BODY``) where it turned more than
-        ``OUT_OF_SIDE_ON_DEG`` toward or away from the camera (one view shows that only by
+        ``side_on.OUT_OF_SIDE_ON_DEG`` toward or away from the camera (one view shows that only by
         foreshortening, and the limbs' hinges then no longer turn in the image plane)."""
         out = {name: c.flag for name, c in self.limbs.items() if c.flag}
-        if self.turned is not None and self.turned > OUT_OF_SIDE_ON_DEG:
+        if out_of_side_on(self.turned):
             out[BODY] = TURNED
         return out
 

@@ -58,6 +58,12 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     return out
 
 
+def out_of_side_on(turned: float | None) -> bool:
+    """Whether a frame's body, ``turned`` degrees (``turned_from``; None where the views
+    look different ways) from its key, is past ``OUT_OF_SIDE_ON_DEG``: a frame to check."""
+    return turned is not None and turned > OUT_OF_SIDE_ON_DEG
+
+
 def turned_from(key: BodyPose, pose: BodyPose) -> float:
     """Degrees the body at ``pose`` has turned toward or away from the first view's camera
     since ``key`` (0 for a turn about the line of sight, which the image shows; a body
