@@ -20,11 +20,14 @@ pixel, affine in the pixel), ``ellipses`` (an ellipsoid's outline), ``at_level``
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from .se3 import Similarity, exp_so3, log_so3
+
+IN_PLACE_PIXELS = 0.5  # parallax of a turning camera's backdrop still taken for none
 
 
 @dataclass
@@ -212,6 +215,24 @@ def intrinsics_problem(K: np.ndarray) -> str:
     if not (K[0, 0] > 0 and K[1, 1] > 0):
         return f"the focal lengths fx = {K[0, 0]:g}, fy = {K[1, 1]:g} (pixels) must be > 0"
     return ""
+
+
+def turn_homography(src: Pinhole, dst: Pinhole) -> np.ndarray:
+    """(3, 3) map of ``src``'s pixels to ``dst``'s, homogeneous, for two pinholes with one
+    centre (a camera turned on a tripod): K_dst R_dst R_src^T K_src^-1, the same for scene
+    points at every depth."""
+    return dst.K @ dst.R @ src.R.T @ np.linalg.inv(src.K)
+
+
+def turns_in_place(cameras: Sequence[Camera], point: np.ndarray) -> bool:
+    """Whether ``cameras`` (one camera on every frame) are pinholes that only turn: their
+    centres so close together that anything at or beyond ``point`` (3,) moves less than
+    ``IN_PLACE_PIXELS`` between them against what ``turn_homography`` says."""
+    if not all(isinstance(c, Pinhole) for c in cameras):
+        return False
+    centres = np.array([c.centre for c in cameras])
+    shift = np.max(np.linalg.norm(centres - centres[0], axis=1))
+    return all(shift * c.scale_at(point) <= IN_PLACE_PIXELS for c in cameras)
 
 
 def _rays(camera: Camera, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

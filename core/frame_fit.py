@@ -148,12 +148,13 @@ class FrameFit:
         images: Sequence[Sequence],
         mode: str = INDEPENDENT,
         settings: TrackerSettings | None = None,
-        moving_views: Sequence[int] = (),
+        moving: Sequence[Sequence | None] | None = None,
         clean_plates: Sequence | None = None,
     ):
-        """``moving_views``: the views whose camera moves (their backdrop with it: no
-        silhouette there). ``clean_plates``: per view, an image (path or array) of its
-        scene without the body, the backdrop of its silhouette, or None."""
+        """``moving``: per view, its camera on every frame where the camera moves, else None
+        (the backdrop moves with it: ``SilhouetteCue``). ``clean_plates``: per view, an image
+        (path or array) of its scene without the body, the backdrop of its silhouette, or
+        None."""
         if mode not in (CALIBRATED, INDEPENDENT):
             raise InputError(f"mode must be '{CALIBRATED}' or '{INDEPENDENT}', not '{mode}'")
         if not skeleton.blobs:
@@ -167,7 +168,7 @@ class FrameFit:
         self.key_sets: dict[tuple[int, int, int], PointSet] = {}
         # the backdrops, once the key frame is known
         self.clean_plates = list(clean_plates or [None] * self.seq.n_views)
-        self._cue = sil.SilhouetteCue(self.seq, moving_views, [
+        self._cue = sil.SilhouetteCue(self.seq, moving, [
             None if p is None else imagelib.grey_and_colour(p) for p in self.clean_plates])
         self.notes: list[str] = []  # what the user should know about the run
         self._use(skeleton)
@@ -226,7 +227,8 @@ class FrameFit:
         bodies = [self._body_mask(key, kin_key, c, self.seq.grey(c, key_frame).shape)
                   for c in range(self.seq.n_views)]
         self.notes += self._cue.start(key_frame, bodies, [
-            sil.BODY_MARGIN * self.scales.magnification(c) for c in range(self.seq.n_views)])
+            sil.BODY_MARGIN * self.scales.magnification(c) for c in range(self.seq.n_views)],
+            key.root_position)
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
                       ) -> tuple[BodyPose, list[str]]:

@@ -51,9 +51,10 @@ class TrackerSettings:
     min_inside: float = _knob(0.5, "Flag a frame when less of the body than this stays "
                               "inside a view's image")
     stop_on_divergence: bool = _knob(True, "Stop at the first flagged frame")
-    silhouette: float = _knob(0.1, "Weight of the body's silhouette against the still "
+    silhouette: float = _knob(0.1, "Weight of the body's silhouette against the "
                               "backdrop (0: off): pulls limbs onto the outline from farther "
-                              "than brightness reaches. Needs cameras that stand still")
+                              "than brightness reaches. Needs cameras that stand still "
+                              "or only turn about their centres")
     silhouette_cap: float = _knob(24.0, "Farthest a silhouette mismatch pulls, in pixels of "
                                   "the full image")
     side_on: bool = _knob(True, "Where every view looks along one line (one view): track "

@@ -1,13 +1,14 @@
-"""The body's silhouette against a still backdrop: a cue whose basin is as wide as a limb is
+"""The body's silhouette against the backdrop: a cue whose basin is as wide as a limb is
 long, where brightness constancy only reaches a blob's width.
 
 Each view's backdrop is the key frame with the body taken out (see ``Backdrop``), or the
 clean plate the user gives (the scene without the body); a pixel is foreground where it
 differs from the backdrop by more than a threshold set from the image's own noise (the
-cameras must stand still). In colour footage, a changed pixel whose colour is the
-backdrop's, darkened or lightened as a shadow does, is unsure: the body's own cast shadow,
-or one the key frame held, on a backdrop whose colour shows it (on a colourless one a
-shadow cannot be told from a grey body, and it stays foreground). Two chamfer terms compare
+cameras stand still, or only turn about their centres: ``TurningBackdrop``). In colour
+footage, a changed pixel whose colour is the backdrop's, darkened or lightened as a shadow
+does, is unsure: the body's own cast shadow, or one the key frame held, on a backdrop whose
+colour shows it (on a colourless one a shadow cannot be told from a grey body, and it stays
+foreground). Two chamfer terms compare
 the blobs' projection (a label map) with the foreground, each in both directions:
 foreground pixels no blob covers pull the nearest covered pixel toward them, and covered
 pixels off the foreground are pulled to the nearest foreground pixel; unsure pixels do
@@ -18,11 +19,14 @@ pull. A foreground map holds one code per pixel: ``BACKDROP``, ``FOREGROUND`` or
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections import deque
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
+from .camera import Camera, Pinhole, turn_homography, turns_in_place
 
 MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called foreground
 UNCOVERED_WEIGHT = 0.3  # of foreground no blob covers: parts the blobs lack (hands, feet)
@@ -35,6 +39,8 @@ BACKDROP_FRAMES = 12  # frames spread over the footage that show the backdrop be
 BACKDROP, FOREGROUND, UNSURE = 0, 1, 2  # a foreground map's codes
 SHADOW_DEPTH = 0.3  # the darkest a shadow leaves its backdrop (sunlight's keep the sky's light)
 NOISE_STRIDE = 4  # rows and columns between the pixels the colour noise is measured on
+TURNING_REACH = 1  # pixels a turning camera's frame may lie off its backdrop (``Backdrop``)
+TURNING_SOURCES = 12  # latest tracked frames a turning camera's backdrop is drawn from
 SHADOW_CHROMA = 6.0  # colour off the backdrop's, in its median over pixels that stay the same,
 # still called the backdrop's own
 
@@ -53,14 +59,17 @@ class Backdrop:
     def __init__(self, grey: np.ndarray, body: np.ndarray,
                  frames: Iterable[tuple[np.ndarray, np.ndarray | None]] = (),
                  margin: int = BODY_MARGIN, colour: np.ndarray | None = None,
-                 clean: bool = False):
+                 clean: bool = False, reach: int = 0):
         """``grey`` float (H, W) and ``colour`` uint8 BGR (H, W, 3) or None: the key frame,
         or, ``clean``, a clean plate (the scene without the body: nothing to paint out);
-        ``body``: the key frame's body pixels; ``frames``: (grey, colour) of other frames."""
+        ``body``: the key frame's body pixels; ``frames``: (grey, colour) of other frames.
+        ``reach``: pixels a frame may lie off the backdrop (a turning camera's, brought into
+        view by a homography: resampled, and turned by the camera's path as given) -- a pixel
+        is foreground only where it is off every backdrop pixel that near."""
         grey = np.asarray(grey, np.float32)
-        self.margin = margin
+        self.margin, self.reach = margin, reach
         # pixels whose backdrop is only painted in
-        self.unseen = np.zeros(body.shape, bool) if clean else self._widen(body)
+        self.unseen = np.zeros(body.shape, bool) if clean else self.widen(body)
         self.image, self.colour = grey.copy(), None if colour is None else colour.copy()
         if self.unseen.any():
             holes = self.unseen.astype(np.uint8)
@@ -93,7 +102,8 @@ class Backdrop:
         found = np.concatenate(found)
         return float(np.median(found)) if len(found) else None
 
-    def _widen(self, body: np.ndarray) -> np.ndarray:
+    def widen(self, body: np.ndarray) -> np.ndarray:
+        """``body`` (H, W) widened by the backdrop's margin."""
         k = np.ones((2 * self.margin + 1,) * 2, np.uint8)
         return cv2.dilate(body.astype(np.uint8), k) > 0
 
@@ -103,32 +113,49 @@ class Backdrop:
         body (its blobs' pixels) is not."""
         if grey.shape != self.image.shape:
             return
-        seen = self.unseen & ~self._widen(body)
+        seen = self.unseen & ~self.widen(body)
         self.image[seen] = grey[seen]
         if self.colour is not None and colour is not None:
             self.colour[seen] = colour[seen]
         self.unseen &= ~seen
 
-    def foreground(self, grey: np.ndarray, colour: np.ndarray | None = None) -> np.ndarray:
+    @property
+    def learning(self) -> bool:
+        """Whether some of it is still only painted in (``learn`` has more to take)."""
+        return bool(self.unseen.any())
+
+    def foreground(self, grey: np.ndarray, colour: np.ndarray | None = None,
+                   against: tuple | None = None) -> np.ndarray:
         """Foreground map (H, W) of a full-resolution frame (grey, and colour or None):
         pixels off the backdrop, specks removed, are ``FOREGROUND``, or ``UNSURE`` where
         their colour is the backdrop's shaded (``shaded``). Holes are kept: the gap between
         an arm and the trunk is one. A frame a few pixels larger or smaller than the
         backdrop is compared where they overlap (top-left corners together); the rest is
-        backdrop."""
-        h, w = (min(a, b) for a, b in zip(grey.shape, self.image.shape))
+        backdrop. ``against``: (grey, colour or None, unknown) of the frame's own size to
+        compare with instead of this backdrop's image (a turning camera's, brought into the
+        frame's view: ``TurningBackdrop``), its unknown pixels ``UNSURE``."""
+        image, backdrop_colour, unknown = against or (self.image, self.colour, None)
+        h, w = (min(a, b) for a, b in zip(grey.shape, image.shape))
         fg = np.zeros(grey.shape, np.uint8)
-        fg[:h, :w] = np.abs(grey[:h, :w] - self.image[:h, :w]) > self.threshold
+        seen, image = grey[:h, :w], image[:h, :w]
+        if self.reach:  # off the range of the backdrop's values that near
+            near = np.ones((2 * self.reach + 1,) * 2, np.uint8)
+            off = np.maximum(cv2.erode(image, near) - seen, seen - cv2.dilate(image, near))
+        else:
+            off = np.abs(seen - image)
+        fg[:h, :w] = off > self.threshold
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
         if self.chroma_noise is not None and colour is not None and \
-                colour.shape == self.colour.shape:
+                backdrop_colour is not None and colour.shape == backdrop_colour.shape:
             ys, xs = np.nonzero(fg)
-            shadow = self.shaded(colour[ys, xs], self.colour[ys, xs])
+            shadow = self.shaded(colour[ys, xs], backdrop_colour[ys, xs])
             unsure = np.zeros(fg.shape, np.uint8)
             unsure[ys[shadow], xs[shadow]] = 1
             # specks too: a shadow is a patch, a lone pixel the backdrop's colour is noise
             unsure = cv2.morphologyEx(unsure, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
             fg[unsure > 0] = UNSURE
+        if unknown is not None:
+            fg[unknown] = UNSURE
         return fg
 
     def shaded(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
@@ -143,6 +170,65 @@ class Backdrop:
         grey = np.repeat(seen[out].astype(np.float32).mean(1, keepdims=True), 3, 1)
         out[out] = _chroma(grey, backdrop[out])[0] > tell  # only where the rest holds
         return out
+
+
+class TurningBackdrop:
+    """The backdrop of a pinhole camera that turns about its centre (panning or tilting on a
+    tripod), for any frame: what the latest tracked frames showed away from their body, then
+    the key frame's ``Backdrop``, each brought into that frame's view by the turn's
+    homography (``turn_homography``), the nearest in time first. Pixels none of them shows
+    (scenery the camera turns onto, or behind a body that has not yet moved off it) are
+    unsure. The key frame's backdrop sets the threshold and the shadow test."""
+
+    def __init__(self, key: Backdrop, key_frame: int, cameras: Sequence[Pinhole]):
+        """``cameras``: the view's camera on every frame of the footage."""
+        self.key, self.key_frame, self.cameras = key, key_frame, cameras
+        # (frame, grey, colour or None, pixels hidden by the body), the latest first; grey
+        # in 8 bits, as footage is (a quarter of the memory of floats)
+        self.sources: deque = deque(maxlen=TURNING_SOURCES)
+        self.learning = True  # every tracked frame shows more
+
+    def foreground(self, frame: int, grey: np.ndarray, colour: np.ndarray | None = None
+                   ) -> np.ndarray:
+        """``Backdrop.foreground`` of ``frame`` against the backdrop as it then looks."""
+        return self.key.foreground(grey, colour, self.seen_from(frame, grey.shape))
+
+    def learn(self, frame: int, grey: np.ndarray, body: np.ndarray,
+              colour: np.ndarray | None = None) -> None:
+        """Keep what tracked ``frame`` shows away from its body (its blobs' pixels)."""
+        self.sources.appendleft((frame, np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8),
+                                 colour, self.key.widen(body)))
+
+    def seen_from(self, frame: int, shape: tuple[int, int]) -> tuple:
+        """The backdrop in ``frame``'s view: grey (H, W), colour (H, W, 3) or None, and the
+        pixels nothing showed (H, W)."""
+        image = np.zeros(shape, np.float32)
+        colour = None if self.key.colour is None else np.zeros((*shape, 3), np.uint8)
+        unknown = np.ones(shape, bool)
+        size = (shape[1], shape[0])
+        for src, grey, col, hidden in (*self.sources, (self.key_frame, self.key.image,
+                                                       self.key.colour, None)):
+            H = turn_homography(self.cameras[src], self.cameras[frame])
+            shows = np.ones(grey.shape, np.float32) if hidden is None else \
+                (~hidden).astype(np.float32)
+            # bilinear: 1 only where every pixel a sample reads from shows the backdrop
+            take = unknown & (cv2.warpPerspective(shows, H, size) > 0.999)
+            if not take.any():
+                continue
+            ys, xs = np.nonzero(take)
+            x0, y0 = xs.min(), ys.min()
+            box = (slice(y0, ys.max() + 1), slice(x0, xs.max() + 1))
+            M = np.array([[1.0, 0, -x0], [0, 1, -y0], [0, 0, 1]]) @ H
+            part = (xs.max() + 1 - x0, ys.max() + 1 - y0)
+            here = take[box]
+            seen = cv2.warpPerspective(grey, M, part)[here]
+            image[box][here] = seen / np.float32(255) if seen.dtype == np.uint8 else seen
+            if colour is not None and col is not None:
+                colour[box][here] = cv2.warpPerspective(col, M, part)[here]
+            unknown &= ~take
+            if not unknown.any():
+                break
+        return image, colour, unknown
 
 
 def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -246,16 +332,22 @@ class SilhouetteCue:
     """One run's silhouette state: each view's backdrop (its clean plate where one is given,
     else the key frame's, made the first time it is asked for and learned from every
     tracked frame), and the foregrounds of the frame being tracked. The tracker says where
-    the body is (its blobs' pixels, full resolution); this object knows only images. A view
-    whose camera is known to move, or whose footage around the body keeps changing (a
-    camera or light moving unannounced), has no backdrop, and a note says so."""
+    the body is (its blobs' pixels, full resolution); this object knows only images and
+    cameras. A view whose camera turns about its centre has its backdrop turned with it
+    (``TurningBackdrop``); one whose camera moves otherwise, or whose footage around the
+    body keeps changing (a camera or light moving unannounced), has no backdrop, and a note
+    says so."""
 
-    def __init__(self, seq, moving: Iterable[int] = (), plates=None):
-        """``plates``: per view, its clean plate as (grey, colour or None), or None."""
+    def __init__(self, seq, moving: Sequence[Sequence[Camera] | None] | None = None,
+                 plates=None):
+        """``moving``: per view, its camera on every frame where the camera moves, else
+        None; ``plates``: per view, its clean plate as (grey, colour or None), or None (a
+        moving camera's is not used)."""
         self.seq = seq  # the run's ImageSequence
-        self.moving = frozenset(moving)  # views whose camera moves
+        self.moving = list(moving) if moving is not None else [None] * seq.n_views
         self.plates = list(plates) if plates is not None else [None] * seq.n_views
-        self.backdrops: list[Backdrop | None] | None = None  # per view; None: not started
+        # per view; None: not started
+        self.backdrops: list[Backdrop | TurningBackdrop | None] | None = None
         self._foregrounds: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
 
     def reset(self) -> None:
@@ -266,34 +358,57 @@ class SilhouetteCue:
     def started(self) -> bool:
         return self.backdrops is not None
 
-    def start(self, key_frame: int, bodies: list[np.ndarray], margins: list[int]) -> list[str]:
+    def start(self, key_frame: int, bodies: list[np.ndarray], margins: list[int],
+              body_at: np.ndarray) -> list[str]:
         """Each view's backdrop: its clean plate, or the key frame with the body
         (``bodies``: per view, its pixels on the key frame) painted out ``margins`` pixels
-        wide; checked against frames spread over the footage. Returns the notes on views
-        whose backdrop does not hold."""
+        wide; checked against frames spread over the footage. ``body_at``: a world point
+        of the body on the key frame (how far a moving camera's backdrop is, at least).
+        Returns the notes on views whose backdrop does not hold."""
         others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
+        others = sorted(set(others) - {key_frame})
         self.backdrops, notes = [], []
-        for c, (body, margin) in enumerate(zip(bodies, margins)):
-            if c in self.moving:
-                notes.append(f"view {c + 1}: its camera moves, and the backdrop with it, so "
-                             "its silhouette is not used")
+        for c, (body, margin, path) in enumerate(zip(bodies, margins, self.moving)):
+            if path is not None and not turns_in_place(path, body_at):
+                notes.append(f"view {c + 1}: its camera moves, and not only turns about its "
+                             "centre, so its backdrop moves with it and its silhouette is "
+                             "not used")
                 self.backdrops.append(None)
                 continue
-            grey, colour = self.plates[c] or (self.seq.grey(c, key_frame),
-                                              self.seq.colour(c, key_frame))
-            backdrop = Backdrop(grey, body, (
-                self.seq.peek(c, f) for f in sorted(set(others) - {key_frame})), margin,
-                colour, clean=self.plates[c] is not None)
+            if path is not None:
+                grey, colour = self.seq.grey(c, key_frame), self.seq.colour(c, key_frame)
+                frames = (self._turned(path, f, key_frame, *self.seq.peek(c, f))
+                          for f in others)
+                backdrop = Backdrop(grey, body, frames, margin, colour, reach=TURNING_REACH)
+            else:
+                grey, colour = self.plates[c] or (self.seq.grey(c, key_frame),
+                                                  self.seq.colour(c, key_frame))
+                backdrop = Backdrop(grey, body, (self.seq.peek(c, f) for f in others),
+                                    margin, colour, clean=self.plates[c] is not None)
             if not backdrop.still:
                 notes.append(f"view {c + 1}: the footage around the body changes from frame "
                              "to frame far more than a body's outline (a moving camera or "
                              "light, or a first pose that does not cover the body), so its "
                              "silhouette is not used")
-            self.backdrops.append(backdrop if backdrop.still else None)
+                self.backdrops.append(None)
+                continue
+            self.backdrops.append(backdrop if path is None else
+                                  TurningBackdrop(backdrop, key_frame, path))
         return notes
 
+    @staticmethod
+    def _turned(path: Sequence[Pinhole], frame: int, to: int, grey: np.ndarray,
+                colour: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+        """A turning camera's ``frame`` (grey, colour) as the camera on frame ``to`` would
+        have seen it; grey is NaN where that frame shows nothing (it counts as neither
+        foreground nor backdrop)."""
+        H = turn_homography(path[frame], path[to])
+        size = (grey.shape[1], grey.shape[0])
+        out = cv2.warpPerspective(grey, H, size, borderValue=float("nan"))
+        return out, None if colour is None else cv2.warpPerspective(colour, H, size)
+
     def has(self, view: int) -> bool:
-        """Whether ``view`` has a still backdrop (after ``start``)."""
+        """Whether ``view`` has a backdrop (after ``start``)."""
         return self.backdrops is not None and self.backdrops[view] is not None
 
     def foreground(self, view: int, frame: int) -> np.ndarray:
@@ -301,15 +416,21 @@ class SilhouetteCue:
         one frame's are kept."""
         if (view, frame) not in self._foregrounds:
             self._foregrounds = {k: v for k, v in self._foregrounds.items() if k[1] == frame}
-            self._foregrounds[view, frame] = self.backdrops[view].foreground(
-                self.seq.grey(view, frame), self.seq.colour(view, frame))
+            bd = self.backdrops[view]
+            seen = (self.seq.grey(view, frame), self.seq.colour(view, frame))
+            self._foregrounds[view, frame] = bd.foreground(frame, *seen) if isinstance(
+                bd, TurningBackdrop) else bd.foreground(*seen)
         return self._foregrounds[view, frame]
 
     def unseen(self, view: int) -> bool:
-        """Whether ``view``'s backdrop still has pixels only painted in."""
-        return self.has(view) and bool(self.backdrops[view].unseen.any())
+        """Whether ``view``'s backdrop can still learn from a tracked frame."""
+        return self.has(view) and self.backdrops[view].learning
 
     def learn(self, view: int, frame: int, body: np.ndarray) -> None:
         """Let ``view``'s backdrop see what ``frame`` shows away from the body there."""
-        self.backdrops[view].learn(self.seq.grey(view, frame), body,
-                                   self.seq.colour(view, frame))
+        bd = self.backdrops[view]
+        seen = (self.seq.grey(view, frame), body, self.seq.colour(view, frame))
+        if isinstance(bd, TurningBackdrop):
+            bd.learn(frame, *seen)
+        else:
+            bd.learn(*seen)

@@ -8,7 +8,8 @@ every view looks along one line the body is tracked side-on (``core.side_on``), 
 from the first pose. A frame whose residual jumps, whose body leaves the images or whose
 system is degenerate is reported as diverged instead of being accepted. A camera that moves
 (a pan, a handheld phone solved in Blender) is given per frame; each frame is seen through
-its cameras as they stood then, and the root's motion stays the body's own, in the world.
+its cameras as they stood then, and the root's motion stays the body's own, in the world;
+a camera that only turns about its centre keeps its silhouette (``core.silhouette``).
 """
 
 from __future__ import annotations
@@ -76,8 +77,7 @@ class Tracker(FrameFit):
         a view whose camera stands still); calibrated mode only. ``clean_plates``: per
         view, an image of its scene without the body, or None (``FrameFit``)."""
         moving = list(moving) if moving is not None else [None] * len(images)
-        super().__init__(skeleton, images, mode, settings,
-                         [c for c, m in enumerate(moving) if m is not None], clean_plates)
+        super().__init__(skeleton, images, mode, settings, moving, clean_plates)
         self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
         self.moving = moving
         if any(m is not None for m in self.moving) and mode != CALIBRATED:

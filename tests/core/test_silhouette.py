@@ -1,14 +1,16 @@
 """The silhouette cue: chamfer mismatches against brute force, a backdrop learned behind a
-body that hardly moves, shadows told from the body by colour, a moving camera noticed, and a
-limb caught beyond brightness's reach."""
+body that hardly moves, shadows told from the body by colour, a camera turning on a tripod
+followed and one moving otherwise noticed, and a limb caught beyond brightness's reach."""
 
 import cv2
 import numpy as np
 import pytest
 
 from core import se3
+from core.camera import Pinhole, turn_homography
 from core.errors import InputError
 from core.pose import INDEPENDENT, BodyPose, apply_update
+from core.sequence import ImageSequence
 from core.settings import TrackerSettings
 from core.silhouette import (
     BACKDROP,
@@ -16,6 +18,7 @@ from core.silhouette import (
     UNSURE,
     Backdrop,
     NearestPixel,
+    SilhouetteCue,
     at_level,
     mismatch,
 )
@@ -276,3 +279,57 @@ def test_a_clean_plate_of_another_size_is_refused_before_tracking():
         track(Tracker(sk, frames, INDEPENDENT, clean_plates=[plate[:, :300]]), pose, range(3))
     res = track(Tracker(sk, frames, INDEPENDENT, clean_plates=[plate]), pose, range(3))
     assert len(res.frames) == 3 and not res.diverged_frames and not res.notes
+
+
+def _turning_footage(centres, n=10, shape=(120, 160), deg_per_frame=1.5, seed=3):
+    """A camera turning ``deg_per_frame`` about its vertical axis in front of a ruled,
+    textured wall, a bright disc (the body) at ``centres(f)`` in the image on frame f:
+    the frames (grey), the body's pixels on each and the camera on each."""
+    rng = np.random.default_rng(seed)
+    K = np.array([[150.0, 0, (shape[1] - 1) / 2], [0, 150, (shape[0] - 1) / 2], [0, 0, 1]])
+    big = (3 * shape[0], 3 * shape[1])
+    wall = cv2.GaussianBlur(rng.uniform(0, 0.6, big).astype(np.float32), (0, 0), 1.5)
+    wall[::15] = wall[:, ::15] = 0.5
+    middle = np.array([[1.0, 0, -shape[1]], [0, 1, -shape[0]], [0, 0, 1]])  # the wall's tile
+    path = [Pinhole(K, se3.exp_so3(np.radians([0, deg_per_frame * f, 0])), np.zeros(3))
+            for f in range(n)]
+    frames, bodies = [], []
+    for f, cam in enumerate(path):
+        img = cv2.warpPerspective(wall, turn_homography(path[0], cam) @ middle,
+                                  (shape[1], shape[0]))
+        body = _disc(shape, centres(f), 14)
+        img[body] = 0.9
+        frames.append(img + rng.normal(0, 0.005, shape).astype(np.float32))
+        bodies.append(body)
+    return frames, bodies, path
+
+
+def test_a_camera_turning_about_its_centre_keeps_its_silhouette():
+    """The camera pans with the body, which stays near mid-image while the wall turns past
+    behind it: the backdrop turned with the camera finds the body on every frame, the
+    scenery the camera turns onto is unsure; told the camera stood still, the backdrop does
+    not hold."""
+    frames, bodies, path = _turning_footage(lambda f: (80 + f, 60))
+    cue = SilhouetteCue(ImageSequence([frames], 1), [path])
+    assert cue.start(0, [bodies[0]], [3], np.array([0.0, 0.0, 5.0])) == []
+    for f in range(1, len(frames)):
+        fg = cue.foreground(0, f)
+        found = fg == FOREGROUND
+        assert (found & bodies[f]).sum() / (found | bodies[f]).sum() > 0.9, f
+        # the camera turns left: the wall it turns onto comes in at the left edge
+        assert (fg[:, :3] == UNSURE).all() and not (fg[8:-8, 8:] == UNSURE).any()
+        cue.learn(0, f, bodies[f])
+    still = SilhouetteCue(ImageSequence([frames], 1))  # told the camera stands still
+    assert "so its silhouette is not used" in still.start(0, [bodies[0]], [3],
+                                                          np.array([0.0, 0.0, 5.0]))[0]
+
+
+def test_a_camera_whose_centre_moves_has_no_silhouette_and_a_note():
+    frames, bodies, path = _turning_footage(lambda f: (80, 60), n=4)
+    # the centre moves a tenth of the distance to the body across the line of sight
+    moved = [Pinhole(c.K, c.R, c.t + [0.1 * f, 0, 0]) for f, c in enumerate(path)]
+    cue = SilhouetteCue(ImageSequence([frames], 1), [moved])
+    assert cue.start(0, [bodies[0]], [3], np.array([0.0, 0.0, 1.0])) == [
+        "view 1: its camera moves, and not only turns about its centre, so its backdrop "
+        "moves with it and its silhouette is not used"]
+    assert not cue.has(0)
