@@ -267,6 +267,14 @@ def command_line(argv: list[str]) -> str:
     return " ".join(["bench/suite.py"] + shown)
 
 
+def settings_phrase(settings: dict) -> str:
+    """How a results file says what the runs were tracked with."""
+    if not settings:
+        return "the default settings"
+    given = ", ".join(f"{k} {json.dumps(v)}" for k, v in settings.items())
+    return f"the default settings but {given}"
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -323,8 +331,8 @@ def main(argv=None) -> int:
         head = [
             "# Benchmark results", "",
             f"Written by `{command_line(argv)}` on {time.strftime('%Y-%m-%d')}. Each clip is two "
-            "seconds of real motion capture rendered in each look and tracked with the "
-            f"default settings and the default blobs, from each of its first {starts} "
+            "seconds of real motion capture rendered in each look and tracked with "
+            f"{settings_phrase(settings)} and the default blobs, from each of its first {starts} "
             "frame(s) (posed there by the capture): tracking is chaotic, so *tracker* is the "
             "mean over those runs, with the lowest and highest beside it. *tracker*, *held "
             "still* (the first frame's pose kept) and *best fit* (the tracked degrees of "

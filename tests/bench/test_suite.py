@@ -222,6 +222,14 @@ def test_a_results_file_names_the_command_that_wrote_it_without_the_writers_fold
     assert command_line([]) == "bench/suite.py"
 
 
+def test_a_results_file_says_which_settings_differ_from_the_defaults():
+    from suite import settings_phrase
+
+    assert settings_phrase({}) == "the default settings"
+    assert settings_phrase({"limb_search": 0, "side_on": False}) == \
+        "the default settings but limb_search 0, side_on false"
+
+
 def test_a_frame_whose_body_turned_out_of_side_on_flags_every_limb_there():
     """The suite's flag counts: a limb counts as flagged by its own flag, or by its frame's
     body having turned past ``OUT_OF_SIDE_ON_DEG`` (the frame is one to check, every limb
