@@ -87,6 +87,10 @@ class Tracker(FrameFit):
             if path is not None and len(path) < self.seq.n_frames():
                 raise InputError(f"view {c + 1}'s camera is given on {len(path)} frames, its "
                                  f"footage has {self.seq.n_frames()}")
+            if path is not None and self.clean_plates[c] is not None:
+                raise InputError(f"view {c + 1}'s camera moves, so one still image of its "
+                                 "scene cannot be its clean plate: clear the clean plate (its "
+                                 "backdrop is then drawn from the footage)")
 
     def _filmed_from(self, pose: BodyPose, frame: int) -> BodyPose:
         """``pose`` seen through each view's camera as it stood on ``frame``."""

@@ -9,7 +9,7 @@ import pytest
 from core import se3
 from core.camera import Pinhole, turn_homography
 from core.errors import InputError
-from core.pose import INDEPENDENT, BodyPose, apply_update
+from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update
 from core.sequence import ImageSequence
 from core.settings import TrackerSettings
 from core.silhouette import (
@@ -333,3 +333,11 @@ def test_a_camera_whose_centre_moves_has_no_silhouette_and_a_note():
         "view 1: its camera moves, and not only turns about its centre, so its backdrop "
         "moves with it and its silhouette is not used"]
     assert not cue.has(0)
+
+
+def test_a_clean_plate_for_a_camera_that_moves_is_refused():
+    frames, _, path = _turning_footage(lambda f: (80, 60), n=3)
+    sk = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
+    with pytest.raises(InputError, match="view 1's camera moves, so one still image of its "
+                                         "scene cannot be its clean plate"):
+        Tracker(sk, [frames], CALIBRATED, moving=[path], clean_plates=[frames[0]])
