@@ -268,17 +268,16 @@ def report(name: str, scores: list[FrameScore], runs: list[list[FrameScore]]) ->
     limbs flagged, beside the first pose carried along."""
     later = scores[1:]
     clicked = not np.isnan(scores[0].clicks)
-    worst = min(s.tracked for s in later)
+    first = {k: v[0] for k, v in summary([scores]).items() if v}
     lines = [f"**{name}** ({len(scores)} frames tracked): the outline's overlap with the "
-             f"silhouette {scores[0].tracked:.2f} on the first frame, then worst {worst:.2f} "
-             f"({worst / scores[0].tracked:.2f}x the first's), mean "
-             f"{np.mean([s.tracked for s in later]):.2f}; the first pose carried along: mean "
-             f"{np.mean([s.carried for s in later]):.2f}."]
+             f"silhouette {scores[0].tracked:.2f} on the first frame, then worst "
+             f"{min(s.tracked for s in later):.2f} ({first['worst_overlap']:.2f}x the "
+             f"first's), mean {np.mean([s.tracked for s in later]):.2f}; the first pose "
+             f"carried along: mean {np.mean([s.carried for s in later]):.2f}."]
     if clicked:
-        lines[-1] += (f" Clicked snout and feet: mean {np.nanmean([s.clicks for s in later]):.1f}"
-                      f" % of the body's length, worst frame "
-                      f"{np.nanmax([s.clicks for s in later]):.1f} %; the first pose carried "
-                      f"along: {np.nanmean([s.clicks_carried for s in later]):.1f} %.")
+        lines[-1] += (f" Clicked snout and feet: mean {first['clicks']:.1f} % of the body's "
+                      f"length, worst frame {first['clicks_worst']:.1f} %; the first pose "
+                      f"carried along: {first['clicks_carried']:.1f} %.")
     m = summary(runs)
     lines[-1] += (f" Over {len(runs)} runs from the clicks as clicked and nudged by a pixel "
                   f"(mean, range): frames tracked {min(m['frames'])}-{max(m['frames'])}, the "
