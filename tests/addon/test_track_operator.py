@@ -104,6 +104,34 @@ def test_perspective_cameras_one_panning_track_through_the_operators(bpy_module,
     assert np.all(legs < 8.0), legs
 
 
+def test_a_camera_turned_by_a_constraint_keeps_its_silhouette(bpy_module, registered,
+                                                             perspective_footage):
+    """The panning camera's turn given by a constraint instead of its own keys (as a Tripod
+    camera solve's constraint gives it): Track reads it on every frame, finds that it only
+    turns (no note), and the legs follow the capture."""
+    bpy = bpy_module
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene, arm = tracking_scene(bpy, perspective_footage, VIEWS, 6, distance=3.5, pan=2.0)
+    cam = scene.twist.views[0].camera
+    turn = bpy.data.objects.new("turn", None)
+    scene.collection.objects.link(turn)
+    turn.rotation_mode = cam.rotation_mode
+    for f in range(1, 7):
+        scene.frame_set(f)
+        turn.rotation_euler = cam.rotation_euler
+        turn.keyframe_insert("rotation_euler", frame=f)
+    cam.animation_data_clear()
+    cam.constraints.new("COPY_ROTATION").target = turn
+    scene.frame_set(1)
+    bridge = registered.twist_addon.bridge
+    assert bridge.camera_path(cam, scene, list(range(1, 7))) is not None
+    assert bpy.ops.twist.track() == {"FINISHED"}
+    assert scene.twist.result.frames_tracked == 5
+    assert "its camera moves" not in scene.twist.result.notes
+    legs = leg_errors(scene, bridge, arm, perspective_footage, range(2, 7))
+    assert np.all(legs < 8.0), legs
+
+
 def test_one_view_tracks_and_notes_the_joints_it_cannot_see_turn_in_depth(bpy_module,
                                                                           registered, footage):
     """Track's note on one line of sight reaches the scene's result, and the Results panel
