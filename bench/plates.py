@@ -34,11 +34,12 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from evaluate import named_point
 from scipy.ndimage import median_filter
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT))  # this tree's core, before anything imports another's
+
+from evaluate import named_point  # noqa: E402
 
 from core import raycast, se3  # noqa: E402
 from core.camera import View  # noqa: E402
