@@ -386,10 +386,13 @@ class SilhouetteCue:
                 backdrop = Backdrop(grey, body, (self.seq.peek(c, f) for f in others),
                                     margin, colour, clean=self.plates[c] is not None)
             if not backdrop.still:
-                notes.append(f"view {c + 1}: the footage around the body changes from frame "
-                             "to frame far more than a body's outline (a moving camera or "
-                             "light, or a first pose that does not cover the body), so its "
-                             "silhouette is not used")
+                notes.append(f"view {c + 1}: " + (
+                    "the footage around the body changes from frame to frame far more than "
+                    "a body's outline (a moving camera or light, or a first pose that does "
+                    "not cover the body)" if path is None else
+                    "its camera's turn, as given, does not line up the scene from frame to "
+                    "frame (check the camera's keys or solve, and its lens)") +
+                    ", so its silhouette is not used")
                 self.backdrops.append(None)
                 continue
             self.backdrops.append(backdrop if path is None else

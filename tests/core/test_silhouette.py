@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from core import se3
+from core import se3, silhouette
 from core.camera import Pinhole, turn_homography
 from core.errors import InputError
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update
@@ -281,21 +281,29 @@ def test_a_clean_plate_of_another_size_is_refused_before_tracking():
     assert len(res.frames) == 3 and not res.diverged_frames and not res.notes
 
 
-def _turning_footage(centres, n=10, shape=(120, 160), deg_per_frame=1.5, seed=3):
-    """A camera turning ``deg_per_frame`` about its vertical axis in front of a ruled,
-    textured wall, a bright disc (the body) at ``centres(f)`` in the image on frame f:
-    the frames (grey), the body's pixels on each and the camera on each."""
+def _turning_footage(centres, n=10, shape=(120, 160), deg_per_frame=1.5, seed=3,
+                     wall="textured"):
+    """A camera turning ``deg_per_frame`` about its vertical axis in front of a wall, a
+    bright disc (the body) at ``centres(f)`` in the image on frame f: the frames (grey), the
+    body's pixels on each and the camera on each. The wall is ruled and ``textured``, or
+    ruled and plain dark (``ruled``, Muybridge's), or dark with large light tiles."""
     rng = np.random.default_rng(seed)
     K = np.array([[150.0, 0, (shape[1] - 1) / 2], [0, 150, (shape[0] - 1) / 2], [0, 0, 1]])
     big = (3 * shape[0], 3 * shape[1])
-    wall = cv2.GaussianBlur(rng.uniform(0, 0.6, big).astype(np.float32), (0, 0), 1.5)
-    wall[::15] = wall[:, ::15] = 0.5
+    back = np.full(big, 0.08, np.float32)
+    if wall == "tiled":
+        for y, x in np.ndindex(big[0] // 30, big[1] // 30):
+            back[30 * y: 30 * y + 12, 30 * x: 30 * x + 12] = 0.6
+    else:
+        if wall == "textured":
+            back = cv2.GaussianBlur(rng.uniform(0, 0.6, big).astype(np.float32), (0, 0), 1.5)
+        back[::15] = back[:, ::15] = 0.5
     middle = np.array([[1.0, 0, -shape[1]], [0, 1, -shape[0]], [0, 0, 1]])  # the wall's tile
     path = [Pinhole(K, se3.exp_so3(np.radians([0, deg_per_frame * f, 0])), np.zeros(3))
             for f in range(n)]
     frames, bodies = [], []
     for f, cam in enumerate(path):
-        img = cv2.warpPerspective(wall, turn_homography(path[0], cam) @ middle,
+        img = cv2.warpPerspective(back, turn_homography(path[0], cam) @ middle,
                                   (shape[1], shape[0]))
         body = _disc(shape, centres(f), 14)
         img[body] = 0.9
@@ -322,6 +330,36 @@ def test_a_camera_turning_about_its_centre_keeps_its_silhouette():
     still = SilhouetteCue(ImageSequence([frames], 1))  # told the camera stands still
     assert "so its silhouette is not used" in still.start(0, [bodies[0]], [3],
                                                           np.array([0.0, 0.0, 5.0]))[0]
+
+
+def test_a_turn_given_wrong_is_noticed_and_said():
+    """A tiled wall, the camera's turn given at a third of what it was: the backdrop does
+    not line up, and the note says to check the camera."""
+    frames, bodies, path = _turning_footage(lambda f: (80 + f, 60), wall="tiled")
+    wrong = [Pinhole(c.K, se3.exp_so3(se3.log_so3(c.R) / 3), c.t) for c in path]
+    cue = SilhouetteCue(ImageSequence([frames], 1), [wrong])
+    assert cue.start(0, [bodies[0]], [3], np.array([0.0, 0.0, 5.0])) == [
+        "view 1: its camera's turn, as given, does not line up the scene from frame to frame "
+        "(check the camera's keys or solve, and its lens), so its silhouette is not used"]
+
+
+def test_a_turned_backdrop_is_matched_within_a_pixel(monkeypatch):
+    """On a plain dark ruled wall the thin lines, resampled twice (by the camera's turn and
+    by the backdrop's), differ from frame to frame by more than the noise: matched within a
+    pixel no line is foreground and the body is; matched exactly, the backdrop does not
+    hold."""
+    frames, bodies, path = _turning_footage(lambda f: (80 + f, 60), wall="ruled")
+    body_at = np.array([0.0, 0.0, 5.0])
+    cue = SilhouetteCue(ImageSequence([frames], 1), [path])
+    assert cue.start(0, [bodies[0]], [3], body_at) == []
+    for f in range(1, len(frames)):
+        found = cue.foreground(0, f) == FOREGROUND
+        assert found[~_disc(found.shape, (80 + f, 60), 20)].mean() < 0.001
+        assert found[bodies[f]].mean() > 0.95
+        cue.learn(0, f, bodies[f])
+    monkeypatch.setattr(silhouette, "TURNING_REACH", 0)
+    exact = SilhouetteCue(ImageSequence([frames], 1), [path])
+    assert "so its silhouette is not used" in exact.start(0, [bodies[0]], [3], body_at)[0]
 
 
 def test_a_camera_whose_centre_moves_has_no_silhouette_and_a_note():
