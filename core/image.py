@@ -108,6 +108,11 @@ def to_float(img: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(img[..., :3] if img.ndim == 3 else img)
 
 
+def to_uint8(img: np.ndarray) -> np.ndarray:
+    """A float image in [0, 1] as 8 bits, rounded to the nearest (beyond the range clipped)."""
+    return np.clip(img * 255 + 0.5, 0, 255).astype(np.uint8)
+
+
 def to_grey(img: np.ndarray) -> np.ndarray:
     """uint8/uint16/float image (H, W[, C]) in BGR(A) order to float32 grey in [0, 1]."""
     img = to_float(img)
@@ -123,7 +128,7 @@ def to_colour(img: np.ndarray) -> np.ndarray | None:
     if img.dtype == np.uint16:
         img = (img >> 8).astype(np.uint8)
     elif img.dtype != np.uint8:
-        img = np.clip(img * 255 + 0.5, 0, 255).astype(np.uint8)
+        img = to_uint8(img)
     if np.array_equal(img[..., 0], img[..., 1]) and np.array_equal(img[..., 1], img[..., 2]):
         return None
     return np.ascontiguousarray(img)

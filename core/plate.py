@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 
 from .errors import InputError
-from .image import load_grey, quiet_stderr
+from .image import load_grey, quiet_stderr, to_uint8
 
 GUTTER_CONTRAST = 0.15  # brightness over the plate's darkest rows still called a gutter
 GUTTER_DIP = 0.65  # a line this much darker than the lightest beside it is a thin gutter
@@ -266,6 +266,6 @@ def write_frames(plate: str | Path, out: str | Path, per_row: int | None = None
     paths = []
     for i, frame in enumerate(frames, 1):
         path = out / f"{plate.stem}_{i:02d}.png"
-        cv2.imwrite(str(path), np.clip(frame * 255 + 0.5, 0, 255).astype(np.uint8))
+        cv2.imwrite(str(path), to_uint8(frame))
         paths.append(path)
     return cells, paths

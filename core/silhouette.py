@@ -27,6 +27,7 @@ import cv2
 import numpy as np
 
 from .camera import Camera, Pinhole, turn_homography, turns_in_place
+from .image import to_float, to_uint8
 
 MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called foreground
 UNCOVERED_WEIGHT = 0.3  # of foreground no blob covers: parts the blobs lack (hands, feet)
@@ -73,7 +74,7 @@ class Backdrop:
         self.image, self.colour = grey.copy(), None if colour is None else colour.copy()
         if self.unseen.any():
             holes = self.unseen.astype(np.uint8)
-            img8 = np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8)
+            img8 = to_uint8(grey)
             self.image = cv2.inpaint(img8, holes, INPAINT_RADIUS,
                                      cv2.INPAINT_TELEA).astype(np.float32) / 255
             if colour is not None:
@@ -196,8 +197,7 @@ class TurningBackdrop:
     def learn(self, frame: int, grey: np.ndarray, body: np.ndarray,
               colour: np.ndarray | None = None) -> None:
         """Keep what tracked ``frame`` shows away from its body (its blobs' pixels)."""
-        self.sources.appendleft((frame, np.clip(grey * 255 + 0.5, 0, 255).astype(np.uint8),
-                                 colour, self.key.widen(body)))
+        self.sources.appendleft((frame, to_uint8(grey), colour, self.key.widen(body)))
 
     def seen_from(self, frame: int, shape: tuple[int, int]) -> tuple:
         """The backdrop in ``frame``'s view: grey (H, W), colour (H, W, 3) or None, and the
@@ -221,8 +221,7 @@ class TurningBackdrop:
             M = np.array([[1.0, 0, -x0], [0, 1, -y0], [0, 0, 1]]) @ H
             part = (xs.max() + 1 - x0, ys.max() + 1 - y0)
             here = take[box]
-            seen = cv2.warpPerspective(grey, M, part)[here]
-            image[box][here] = seen / np.float32(255) if seen.dtype == np.uint8 else seen
+            image[box][here] = to_float(cv2.warpPerspective(grey, M, part)[here])
             if colour is not None and col is not None:
                 colour[box][here] = cv2.warpPerspective(col, M, part)[here]
             unknown &= ~take
