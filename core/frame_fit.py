@@ -36,7 +36,14 @@ from . import silhouette as sil
 from .confidence import MIN_LIMB_POINTS, LimbCheck, Limbs
 from .errors import InputError
 from .linearize import Kinematics, rows
-from .pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, n_root_params
+from .pose import (
+    CALIBRATED,
+    INDEPENDENT,
+    ROOT_PARAMS,
+    BodyPose,
+    apply_update,
+    n_root_params,
+)
 from .scales import Scales
 from .search import LimbSearch
 from .sequence import ImageSequence
@@ -171,6 +178,8 @@ class FrameFit:
         self._cue = sil.SilhouetteCue(self.seq, moving, [
             None if p is None else imagelib.grey_and_colour(p) for p in self.clean_plates])
         self.notes: list[str] = []  # what the user should know about the run
+        # side-on: the root's turns toward and away from the line of sight are held
+        self.hold_turn_in_depth = False
         self._use(skeleton)
 
     def _use(self, skeleton: Skeleton) -> None:
@@ -326,8 +335,26 @@ class FrameFit:
         root = pose.root_position
         scale = max(v.scale_at(root) for v in pose.views) / 2**level
         nr = self.n_params - self.n_dof
-        return np.concatenate([np.ones(nr, bool),
+        roots = np.ones(nr, bool)
+        if self.hold_turn_in_depth:  # the turns across the image (``_unknowns``)
+            across = np.arange(0, nr, ROOT_PARAMS)
+            roots[across + 3] = roots[across + 4] = False
+        return np.concatenate([roots,
                                self.dof_thickness * scale >= self.settings.min_blob_pixels])
+
+    def _unknowns(self, pose: BodyPose) -> np.ndarray | None:
+        """The orthogonal change T (P, P) from the unknowns the system is solved in to the
+        pose's parameters (``apply_update``: step = T x), or None for the parameters
+        themselves. Side-on, each root turn is solved about the first view's camera axes (its
+        x and y across the image, then its line of sight) so that ``_active`` can hold the
+        turns toward and away from the camera, which one line of sight shows only as
+        foreshortening, the same for either sign. A view's own root (independent mode) turns
+        in its camera's frame already."""
+        if not self.hold_turn_in_depth or self.mode != CALIBRATED:
+            return None
+        T = np.eye(self.n_params)
+        T[3:6, 3:6] = pose.views[0].orientation.T  # camera axes as world vectors
+        return T
 
     # --- point sets ---------------------------------------------------------------------
     def point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
@@ -596,15 +623,17 @@ class FrameFit:
                 return FrameResult(frame=frame, pose=est, residual=float("nan"),
                                    iterations=total_iters, converged=False, diverged=True,
                                    reason=left, seconds=time.perf_counter() - t0)
-            ne = self._normal_equations(kin, sets, smp, sigmas, level)
+            T = self._unknowns(est)
+            ne = self._normal_equations(kin, sets, smp, sigmas, level).changed(T)
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
             converged = False
             for it in range(s.iterations):
                 total_iters += 1
-                delta = self._within_limits(est, self._trust(solve(ne, lam, prior, offset,
-                                                                    active)))
-                cand = apply_update(self.skeleton, est, delta, self.mode)
+                x = solve(ne, lam, prior, offset, active)
+                step = self._within_limits(est, self._trust(x if T is None else T @ x))
+                delta = step if T is None else T.T @ step  # in the solved unknowns
+                cand = apply_update(self.skeleton, est, step, self.mode)
                 kin_c = Kinematics(self.skeleton, cand)
                 c_smp = self.sample(cand, kin_c, sets, levels, level, sigmas, fgs)
                 # compare on the pixels seen in both poses: a step must not win by hiding pixels
@@ -622,7 +651,7 @@ class FrameFit:
                         converged = True
                         break
                     if it + 1 < s.iterations:
-                        ne = self._normal_equations(kin, sets, smp, sigmas, level)
+                        ne = self._normal_equations(kin, sets, smp, sigmas, level).changed(T)
                 else:
                     lam *= 4
                     if lam > 1e4:

@@ -1,8 +1,9 @@
 """Side-on: where every view looks along one line, the joints that would turn the limbs
 toward or away from the cameras become hinges about that line, as the paper tracks a body
-seen by one camera. The footage shows such a turn only as foreshortening, the same for
-either sign; as hinges in the image plane, the limbs follow what the footage shows and
-what it does not is held. Views that look different ways leave the body as it is."""
+seen by one camera, and the root turns only about it (``FrameFit.hold_turn_in_depth``).
+The footage shows such a turn only as foreshortening, the same for either sign; in the
+image plane, the body follows what the footage shows and what it does not is held. Views
+that look different ways leave the body as it is."""
 
 from __future__ import annotations
 

@@ -42,6 +42,13 @@ class NormalEquations:
     def zeros(cls, n: int) -> NormalEquations:
         return cls(np.zeros((n, n)), np.zeros(n))
 
+    def changed(self, T: np.ndarray | None) -> NormalEquations:
+        """The same equations in unknowns x with parameters ``T`` x (T (P, P) orthogonal;
+        None: these)."""
+        if T is None:
+            return self
+        return NormalEquations(T.T @ self.H @ T, T.T @ self.b, self.rows)
+
     def add(self, A: np.ndarray, r: np.ndarray, w: np.ndarray) -> None:
         """Add rows A (N, P), residuals r (N,) and IRLS weights w (N,)."""
         Aw = A * w[:, None]

@@ -4,9 +4,10 @@ Each new frame's pose is predicted from the last two (constant velocity; a limit
 that its speed would carry past its limits, or a limb no view saw, is held where it was),
 then fitted to the frame. The first frame's pose is the user's and the first key frame; a
 frame the user corrected takes the user's pose and becomes the key frame after it. Where
-every view looks along one line the body is tracked side-on (``core.side_on``), decided
-from the first pose. A frame whose residual jumps, whose body leaves the images or whose
-system is degenerate is reported as diverged instead of being accepted. A camera that moves
+every view looks along one line the body is tracked side-on (``core.side_on``; its root's
+turn toward or away from the camera held), decided from the first pose. A frame whose
+residual jumps, whose body leaves the images or whose system is degenerate is reported as
+diverged instead of being accepted. A camera that moves
 (a pan, a handheld phone solved in Blender) is given per frame; each frame is seen through
 its cameras as they stood then, and the root's motion stays the body's own, in the world;
 a camera that only turns about its centre keeps its silhouette (``core.silhouette``).
@@ -180,6 +181,7 @@ class Tracker(FrameFit):
         self.notes = []
         blind = depth_blind_joints(self.given_skeleton, initial)
         side_on = bool(blind) and self.settings.side_on
+        self.hold_turn_in_depth = side_on
         if self.settings.side_on:
             self._use(side_on_skeleton(self.given_skeleton, initial))
             if blind:
