@@ -47,6 +47,26 @@ def test_inactive_unknowns_stay_put_and_the_rest_solve_their_subsystem():
     np.testing.assert_allclose(step[active], np.linalg.lstsq(sub, -r, rcond=None)[0], rtol=1e-9)
 
 
+def test_equations_in_turned_unknowns_give_the_same_step_and_hold_a_direction():
+    """``NormalEquations.changed``: solved in unknowns x with parameters T x (T orthogonal),
+    the undamped step T x is the one solved directly; holding one of x holds the parameters
+    to the plane T's other columns span, where the step is least squares (against lstsq on
+    the rows A T with that column left out)."""
+    rng = np.random.default_rng(4)
+    A, r = rng.normal(size=(80, 5)), rng.normal(size=80)
+    ne = NormalEquations.zeros(5)
+    ne.add(A, r, np.ones(80))
+    T = np.linalg.qr(rng.normal(size=(5, 5)))[0]
+    turned = ne.changed(T)
+    np.testing.assert_allclose(T @ solve(turned, 0.0), solve(ne, 0.0), rtol=1e-9)
+    assert ne.changed(None) is ne
+    active = np.array([True, True, False, True, True])
+    step = T @ solve(turned, 0.0, active=active)
+    assert abs(step @ T[:, 2]) < 1e-12
+    x = np.linalg.lstsq((A @ T)[:, active], -r, rcond=None)[0]
+    np.testing.assert_allclose(step, T[:, active] @ x, rtol=1e-9)
+
+
 def test_an_unknown_only_rounding_errors_see_stays_put():
     """A column of rounding errors (1e-17 of the others: a root's translation along the line
     of sight of one view turned off the world's axes) is an unknown nothing sees; scaled like
