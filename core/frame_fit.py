@@ -40,6 +40,7 @@ from .pose import (
     CALIBRATED,
     INDEPENDENT,
     ROOT_PARAMS,
+    ROOT_TURN,
     BodyPose,
     apply_update,
     n_root_params,
@@ -337,8 +338,8 @@ class FrameFit:
         nr = self.n_params - self.n_dof
         roots = np.ones(nr, bool)
         if self.hold_turn_in_depth:  # the turns across the image (``_unknowns``)
-            across = np.arange(0, nr, ROOT_PARAMS)
-            roots[across + 3] = roots[across + 4] = False
+            across = np.arange(0, nr, ROOT_PARAMS) + ROOT_TURN.start
+            roots[across] = roots[across + 1] = False
         return np.concatenate([roots,
                                self.dof_thickness * scale >= self.settings.min_blob_pixels])
 
@@ -353,7 +354,7 @@ class FrameFit:
         if not self.hold_turn_in_depth or self.mode != CALIBRATED:
             return None
         T = np.eye(self.n_params)
-        T[3:6, 3:6] = pose.views[0].orientation.T  # camera axes as world vectors
+        T[ROOT_TURN, ROOT_TURN] = pose.views[0].orientation.T  # camera axes, world vectors
         return T
 
     # --- point sets ---------------------------------------------------------------------

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .pose import CALIBRATED, ROOT_PARAMS, BodyPose, n_root_params
+from .pose import CALIBRATED, ROOT_PARAMS, ROOT_TURN, BodyPose, n_root_params
 from .skeleton import Skeleton
 
 
@@ -79,13 +79,13 @@ def rows(
     xm = _cross(X - c, m)
     if mode == CALIBRATED:
         A[:, 0:3] = m
-        A[:, 3:6] = xm
+        A[:, ROOT_TURN] = xm
     else:
         o = ROOT_PARAMS * view_index
         d = view.scaled(X) - view.scaled(c)  # from the root's image point
         A[:, o] = grad[:, 0] * d[:, 0] + grad[:, 1] * d[:, 1]
         A[:, o + 1 : o + 3] = grad
-        A[:, o + 3 : o + 6] = _cross_g(d, grad)
+        A[:, o:][:, ROOT_TURN] = _cross_g(d, grad)
     if D:
         a = kin.dof_axis_world
         J = xm @ a.T - m @ _cross(a, kin.dof_point_world - c).T

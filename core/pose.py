@@ -30,6 +30,9 @@ from .skeleton import Skeleton
 
 CALIBRATED, INDEPENDENT = "calibrated", "independent"
 ROOT_PARAMS = 6
+# where each root block (the shared root, or one view's) holds its turn: after the
+# translation, or after the scale and the image shift
+ROOT_TURN = slice(3, 6)
 
 
 @dataclass
@@ -62,14 +65,14 @@ def apply_update(
     new = pose.copy()
     nr = n_root_params(mode, len(pose.views))
     if mode == CALIBRATED:
-        dv, dw = delta[:3], delta[3:6]
+        dv, dw = delta[:3], delta[ROOT_TURN]
         E = se3.exp_so3(dw)
         new.rotations[0] = E @ pose.rotations[0]
         new.root_position = pose.root_position + dv  # rotation is about the root itself
     else:
         for c, view in enumerate(pose.views):
             ds, dv1, dv2 = delta[6 * c : 6 * c + 3]
-            E = se3.exp_so3(delta[6 * c + 3 : 6 * c + 6])
+            E = se3.exp_so3(delta[ROOT_PARAMS * c :][ROOT_TURN])
             P = view.pose
             q_r = P.apply(np.asarray(pose.root_position, dtype=float))
             s_new = P.s * (1 + ds)

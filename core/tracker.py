@@ -7,9 +7,9 @@ frame the user corrected takes the user's pose and becomes the key frame after i
 every view looks along one line the body is tracked side-on (``core.side_on``; its root's
 turn toward or away from the camera held), decided from the first pose. A frame whose
 residual jumps, whose body leaves the images or whose system is degenerate is reported as
-diverged instead of being accepted. A camera that moves
-(a pan, a handheld phone solved in Blender) is given per frame; each frame is seen through
-its cameras as they stood then, and the root's motion stays the body's own, in the world;
+diverged instead of being accepted. A camera that moves (a pan, a handheld phone solved
+in Blender) is given per frame; each frame is seen through its cameras as they stood
+then, and the root's motion stays the body's own, in the world;
 a camera that only turns about its centre keeps its silhouette (``core.silhouette``).
 """
 
