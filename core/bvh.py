@@ -10,6 +10,7 @@ the root hold its absolute position; on another joint they are added to its offs
 from __future__ import annotations
 
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -94,11 +95,7 @@ class BvhFile:
         cols = []
         for j, joint in enumerate(self.joints):
             rot = [c for c in joint.channels if c in _ROT]
-            euler = (
-                Rotation.from_matrix(rotations[:, j]).as_euler(joint.rotation_order, degrees=True)
-                if rot
-                else np.zeros((F, 0))
-            )
+            euler = _euler(rotations[:, j], joint.rotation_order) if rot else np.zeros((F, 0))
             k = 0
             for c in joint.channels:
                 if c in _ROT:
@@ -208,6 +205,15 @@ def read_bvh(path: str | Path) -> BvhFile:
             )
         motion[i] = [float(v) for v in vals]
     return BvhFile(joints, motion, float(m_time.group(1)))
+
+
+def _euler(rotations: np.ndarray, order: str) -> np.ndarray:
+    """Angles (F, 3) in degrees, in ``order``, of rotations (F, 3, 3). At gimbal lock (the
+    middle angle at +-90 degrees) scipy warns and sets the third angle to zero; the angles
+    still compose to the same rotation, so the warning is not passed on."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "Gimbal lock detected", UserWarning)
+        return Rotation.from_matrix(rotations).as_euler(order, degrees=True)
 
 
 def write_bvh(bvh: BvhFile, path: str | Path) -> None:

@@ -1,5 +1,7 @@
 """BVH reading and writing against the file's own numbers and hand-built rotations."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -50,6 +52,19 @@ def test_write_then_read_round_trips(tmp_path, cmu_walk):
     R2, p2 = back.poses()
     assert np.max(np.degrees(se3.rotation_angle_between(R, R2))) < 1e-4
     np.testing.assert_allclose(p2, p, atol=1e-6)
+
+
+def test_a_joint_turned_into_gimbal_lock_is_written_exactly_and_quietly(tmp_path, cmu_walk):
+    b = read_bvh(cmu_walk)
+    R, p = b.poses(np.arange(100, 102))
+    knee = b.names.index("LeftKnee")  # channels Z, Y, X: Y at 90 degrees locks Z with X
+    R[0, knee] = _axis_rotation("Z", 30) @ _axis_rotation("Y", 90) @ _axis_rotation("X", 40)
+    R[1, knee] = _axis_rotation("Z", -20) @ _axis_rotation("Y", -90) @ _axis_rotation("X", 10)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # scipy's warning on the lock would fail the test
+        write_bvh(b.with_motion(R, p), tmp_path / "locked.bvh")
+    R2, _ = read_bvh(tmp_path / "locked.bvh").poses()
+    assert np.max(np.degrees(se3.rotation_angle_between(R, R2))) < 1e-4
 
 
 @pytest.mark.parametrize(
