@@ -1,13 +1,15 @@
 """The real four-camera clip (Pose2Sim's demo, ``bench/data/pose2sim``) tracked as a user
 would, through its own calibration, and scored against reference 2-D landmarks.
 
-    python bench/real_clip.py [--frames N] [--stiff-back] [--write PATH] [--sheet PATH]
+    python bench/real_clip.py [--frames N] [--starts N] [--stiff-back] [--write PATH]
+                              [--sheet PATH]
 
 A human template (metres; its lower back free, as the suite's three-view runs have it) is
 fitted to the first frame's reference landmarks in all four
 views (``python -m core fit``: they stand in for a user's clicks, undistorted through the
 calibration's lens model), then every frame of the four movies is tracked with the default
-settings (``python -m core track``), each camera the calibration's pinhole. Score: per view
+settings (``core.run.run_job``, what ``python -m core track`` runs), each camera the
+calibration's pinhole. Score: per view
 and frame, the mean image distance of the tracked joints (shoulders, elbows, wrists, hips,
 knees, ankles), projected through the calibration's lens, to MediaPipe's landmarks (those
 it calls visible), in % of the body's height in that view, left and right taken the way
@@ -44,6 +46,7 @@ from core.init_fit import fit_pose  # noqa: E402
 from core.job import load_job  # noqa: E402
 from core.lens import Undistorted, distort_points, undistort_points  # noqa: E402
 from core.pose import BodyPose  # noqa: E402
+from core.run import report, result_bvh, run_job  # noqa: E402
 from core.skeleton import BALL, HINGE, Skeleton, human_template  # noqa: E402
 from core.video import VideoFrames  # noqa: E402
 
@@ -183,53 +186,90 @@ def fitted_each_frame(sk: Skeleton, poses: list, cams, views, mode: str, landmar
     return out
 
 
-def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None) -> list[str]:
-    """Fit, track and score the clip's first ``frames`` frames; the result as Markdown (and
-    with ``sheet``, a contact sheet of the first, middle and last frames there)."""
+def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
+        starts: int = 1) -> list[str]:
+    """Fit, track and score the clip's first ``frames`` frames, from its first frame and, with
+    ``starts`` over 1, from each of the next ones too (the spread a difference must beat);
+    the result as Markdown (and with ``sheet``, a contact sheet of the first, middle and
+    last frames of the run from the first frame there)."""
     WORK.mkdir(parents=True, exist_ok=True)
     sk = human_template(lower_back=lower_back)
     cams = read_calibration(DATA / "Calib.qca.txt")
     lm = np.load(DATA / "mediapipe_landmarks.npz")
     landmarks, visibility = lm["xy"].astype(float), lm["visibility"]
     assert [str(n) for n in lm["names"]] == [c.name for c in cams]
-    ideal = {k: np.array([undistort_points(landmarks[c, 0, i][None], cam.camera.K, cam.dist)[0]
-                          for c, cam in enumerate(cams)]) for k, i in POINTS.items()}
     write_bvh(template_bvh(sk), WORK / "template.bvh")
-    R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal)
-    write_bvh(template_bvh(sk).with_motion(R0[None], root0[None]), WORK / "guess.bvh")
-    views = [{"camera": {"calibration": str(DATA / "Calib.qca.txt"), "name": c.name}}
-             for c in cams]
-    clicks = [{k: landmarks[c, 0, i].tolist() for k, i in POINTS.items()
-               if visibility[c, 0, i] > VISIBLE} for c in range(len(cams))]
-    fit = {"skeleton": {"bvh": "template.bvh", "joints": joint_spec(sk)},
-           "initial": {"bvh": "guess.bvh"}, "views": views, "mode": "calibrated",
-           "clicks": clicks}
-    (WORK / "fit.json").write_text(json.dumps(fit, indent=1))
-    fit_log = _run("fit", WORK / "fit.json", "--out", WORK / "fitted.bvh").stderr.strip()
-    job = {"skeleton": {"bvh": "fitted.bvh", "joints": joint_spec(sk)},
-           "initial": {"bvh": "fitted.bvh"}, "mode": "calibrated", "frame_time": 1.0 / FPS,
-           "views": [dict(v, images=str(DATA / f"{c.name}.mp4")) for v, c in zip(views, cams)]}
-    if frames < len(landmarks[0]):
-        _trim_movies(cams, frames, job)
-    (WORK / "job.json").write_text(json.dumps(job, indent=1))
-    t0 = time.perf_counter()
-    _run("track", WORK / "job.json", "--out", WORK / "tracked.bvh", "--report",
-         WORK / "report.json", "--quiet")
-    seconds = time.perf_counter() - t0
-    tracked_job = load_job(WORK / "job.json")
-    fsk = tracked_job.skeleton  # the fitted body, with the blobs it tracked
-    R, p = read_bvh(WORK / "tracked.bvh").poses()
-    tracked = list(zip(R, p))
+    runs = [_track_from(k, frames, sk, cams, landmarks, visibility) for k in range(starts)]
+    fsk, tracked, job, fit_log, seconds, rep = runs[0]
     e_track = errors_pct(fsk, tracked, cams, landmarks, visibility)
     e_still = errors_pct(fsk, [tracked[0]] * len(tracked), cams, landmarks, visibility)
-    floor = fitted_each_frame(fsk, tracked, cams, tracked_job.initial.views, tracked_job.mode,
-                              landmarks, visibility)
+    floor = fitted_each_frame(fsk, tracked, cams, job.initial.views, job.mode, landmarks,
+                              visibility)
     e_floor = errors_pct(fsk, floor, cams, landmarks, visibility)
-    rep = json.loads((WORK / "report.json").read_text())
     if sheet is not None:
         n = len(tracked)
         contact_sheet(fsk, tracked, cams, [0, n // 2, n - 1], sheet)
-    return _table(e_track, e_still, e_floor, rep, fit_log, seconds, lower_back)
+    lines = _table(e_track, e_still, e_floor, rep, fit_log, seconds, lower_back)
+    if starts > 1:
+        per_frame = [np.nanmean(errors_pct(r[0], r[1], cams, landmarks[:, k:], visibility[:, k:]),
+                                axis=1) for k, r in enumerate(runs)]
+        lines += ["", _spread([np.mean(e) for e in per_frame],
+                              [np.mean(e[-5:]) for e in per_frame])]
+    return lines
+
+
+def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
+                visibility: np.ndarray) -> tuple:
+    """The template fitted to frame ``start``'s landmarks (``core fit``) and tracked from
+    there to frame ``frames`` - 1 with the default settings, in ``WORK`` (a folder of its
+    own for a later start): (the fitted body, the tracked (rotations, root) per frame, the
+    job, the fit's log, seconds tracking, the report)."""
+    work = WORK if start == 0 else WORK / f"from_{start}"
+    work.mkdir(exist_ok=True)
+    ideal = {k: np.array([undistort_points(landmarks[c, start, i][None], cam.camera.K,
+                                           cam.dist)[0] for c, cam in enumerate(cams)])
+             for k, i in POINTS.items()}
+    R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal)
+    write_bvh(template_bvh(sk).with_motion(R0[None], root0[None]), work / "guess.bvh")
+    views = [{"camera": {"calibration": str(DATA / "Calib.qca.txt"), "name": c.name}}
+             for c in cams]
+    clicks = [{k: landmarks[c, start, i].tolist() for k, i in POINTS.items()
+               if visibility[c, start, i] > VISIBLE} for c in range(len(cams))]
+    skeleton = {"bvh": str(WORK / "template.bvh"), "joints": joint_spec(sk)}
+    fit = {"skeleton": skeleton, "initial": {"bvh": "guess.bvh"}, "views": views,
+           "mode": "calibrated", "clicks": clicks}
+    (work / "fit.json").write_text(json.dumps(fit, indent=1))
+    fit_log = _run("fit", work / "fit.json", "--out", work / "fitted.bvh").stderr.strip()
+    spec = {"skeleton": {"bvh": "fitted.bvh", "joints": joint_spec(sk)},
+            "initial": {"bvh": "fitted.bvh"}, "mode": "calibrated", "frame_time": 1.0 / FPS,
+            "views": [dict(v, images=str(DATA / f"{c.name}.mp4")) for v, c in zip(views, cams)]}
+    (work / "job.json").write_text(json.dumps(spec, indent=1))
+    job = load_job(work / "job.json")  # the fitted body, with the blobs it tracks
+    job.images = [_frames(movie, start, frames) for movie in job.images]
+    t0 = time.perf_counter()
+    result = run_job(job)
+    seconds = time.perf_counter() - t0
+    write_bvh(result_bvh(job, result), work / "tracked.bvh")
+    rep = report(job, result, seconds)
+    (work / "report.json").write_text(json.dumps(rep, indent=1))
+    R, p = read_bvh(work / "tracked.bvh").poses()
+    return job.skeleton, list(zip(R, p)), job, fit_log, seconds, rep
+
+
+def _frames(movie, start: int, stop: int):
+    """A view's movie frames ``start`` to ``stop`` - 1 (read undistorted as the movie is)."""
+    if isinstance(movie, Undistorted):
+        return Undistorted(_frames(movie.source, start, stop), movie.K, movie.dist, movie.size)
+    return movie.select(list(range(start, min(stop, len(movie)))))
+
+
+def _spread(means: list[float], last_fives: list[float]) -> str:
+    """One line on the runs from several starting frames."""
+    def stat(x):
+        return f"{np.mean(x):.1f} ({min(x):.1f}-{max(x):.1f})"
+    return (f"From frames 0-{len(means) - 1}, each start's first pose fitted to that frame's "
+            f"landmarks (mean over the starts, their range): all frames {stat(means)}, last "
+            f"five {stat(last_fives)}: a change inside that range is no change.")
 
 
 def main(argv=None) -> int:
@@ -239,8 +279,10 @@ def main(argv=None) -> int:
                     help="the paper's 19-DOF template: the lower back not free")
     ap.add_argument("--write", help="a Markdown file to write the result into")
     ap.add_argument("--sheet", type=Path, help="a contact sheet (JPEG) to write")
+    ap.add_argument("--starts", type=int, default=1,
+                    help="also track from each of the next starts - 1 frames (the spread)")
     args = ap.parse_args(argv)
-    lines = run(args.frames, not args.stiff_back, args.sheet)
+    lines = run(args.frames, not args.stiff_back, args.sheet, args.starts)
     print("\n".join(lines))
     if args.write:
         Path(args.write).write_text("\n".join([
@@ -280,16 +322,6 @@ def contact_sheet(sk: Skeleton, poses: list, cams, frames: list[int], path: Path
                                     interpolation=cv2.INTER_AREA))
         rows.append(np.hstack(tiles))
     cv2.imwrite(str(path), np.vstack(rows), [cv2.IMWRITE_JPEG_QUALITY, 80])
-
-
-def _trim_movies(cams, n: int, job: dict) -> None:
-    """The first ``n`` frames of each movie as PNG files, the job's views pointed at them."""
-    for v, c in zip(job["views"], cams):
-        folder = WORK / c.name
-        folder.mkdir(exist_ok=True)
-        for f, img in zip(range(n), VideoFrames(DATA / f"{c.name}.mp4")):
-            cv2.imwrite(str(folder / f"{f:04d}.png"), img)
-        v["images"] = f"{c.name}/*.png"
 
 
 def _table(e_track, e_still, e_floor, rep, fit_log, seconds, lower_back) -> list[str]:
