@@ -78,6 +78,9 @@ class FrameResult:
     given: bool = False  # the user's pose (the initial one or a correction), not tracked
     limbs: dict[str, LimbCheck] = field(default_factory=dict)  # tracked frames: each limb's
     turned: float | None = None  # side-on: degrees the body turned in depth since the key
+    # joints the limb search turned on this frame on two or more views' evidence: their step
+    # from the frame before is mostly the error the turn took out, not motion
+    searched: list[str] = field(default_factory=list)
 
     @property
     def flagged(self) -> dict[str, str]:
@@ -255,8 +258,11 @@ class FrameFit:
         return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
 
     def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
-                   sets: list[PointSet], levels: list, level: int) -> BodyPose:
-        """``est`` with the turns of ``searched`` that the pixels bear out: a limb's turn is
+                   sets: list[PointSet], levels: list, level: int
+                   ) -> tuple[BodyPose, list[str]]:
+        """``est`` with the turns of ``searched`` that the pixels bear out, and the joints
+        so turned where two or more views bore the turn out (``FrameResult.searched``): a
+        limb's turn is
         kept only when, in every view that sees the limb, its pixels of the earlier frames
         match the new image clearly better turned than not (``_clearly_lower``); else the
         limb keeps its predicted motion. The silhouette proposes, brightness decides: an
@@ -272,7 +278,7 @@ class FrameFit:
         moved = self.skeleton.moved_by()
         bounds = np.cumsum([0] + [len(ps.value) for ps in sets])
         keys = [ps.key_points() for ps in sets]
-        out = est
+        out, kept = est, []
         for limb in self._search.limbs:
             if self.skeleton.names[limb.joint] not in turned:
                 continue
@@ -298,7 +304,10 @@ class FrameFit:
                                 and _clearly_lower(new[key], old[key]))
             if clear == seen or (seen > 1 and vouched == seen):
                 out = cand
-        return out
+                if seen > 1:
+                    kept += [self.skeleton.names[j] for j, _, _ in limb.dofs
+                             if not np.allclose(cand.rotations[j], est.rotations[j])]
+        return out, kept
 
     def scale_to(self, pose: BodyPose) -> None:
         """Fit each view's pyramid to the body's size there at ``pose`` (``auto_scale``);
@@ -592,6 +601,7 @@ class FrameFit:
         est = predicted
         offset = np.zeros(self.n_params)
         total_iters = 0
+        searched_joints: list[str] = []
         converged = False
         kin_prev, kin_key = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, key)
         for level in reversed(range(self.scales.n_levels())):
@@ -611,7 +621,8 @@ class FrameFit:
             if s.limb_search > 0 and level == self.scales.search_level():
                 searched, turned = self._search_limbs(est, frame, key, key_frame)
                 if turned:
-                    searched = self._evidenced(est, searched, turned, sets, levels, level)
+                    searched, searched_joints = self._evidenced(est, searched, turned, sets,
+                                                                levels, level)
                 if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)
@@ -660,7 +671,8 @@ class FrameFit:
                         break
         result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
                              iterations=total_iters, converged=converged,
-                             limbs=self._limb_checks(kin, sets, smp, fgs))
+                             limbs=self._limb_checks(kin, sets, smp, fgs),
+                             searched=searched_joints)
         left = self._left_views(smp)
         if left:
             result.diverged, result.reason = True, left

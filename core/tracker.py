@@ -139,8 +139,13 @@ class Tracker(FrameFit):
         limited hinge whose turn would carry it past its limits is predicted where it was:
         carried on, an elbow the limb search had just turned 75 degrees wrapped round past 180
         and came out bent backward; stopped at the limit, it was 30 degrees off. The joints
-        ``held`` (limbs no view saw on the last frame) are predicted where they were: the
-        footage did not show their motion."""
+        ``held`` are predicted where they were: limbs no view saw on the last frame (the
+        footage did not show their motion), and those the limb search turned there on two
+        or more views' evidence (views that agree a limb was off: its last step was mostly
+        the error the turn took out, and carried on it threw the limb as far off the other
+        way on the next frame, as a user's correction would). A turn one view bore out keeps
+        its speed: a plate's leg turns 20-40 degrees a cell, past the differential step, and
+        the search is how its motion is followed at all."""
         pred = extrapolate(before, last, self.settings.prediction_gain)
         held_joints = {self.skeleton.index(name) for name in held}
         for j in held_joints:
@@ -214,9 +219,9 @@ class Tracker(FrameFit):
                 # the error the correction takes out, which carried on flung the next frames
                 history = history[-1:] + [res] if prev.given else [res]
                 continue
-            unseen = [n for n, why in prev.flagged.items() if why == UNSEEN]
+            held = [n for n, why in prev.flagged.items() if why == UNSEEN] + prev.searched
             pred = self._filmed_from(
-                self.predict(history[-2].pose, prev.pose, unseen) if len(history) >= 2
+                self.predict(history[-2].pose, prev.pose, held) if len(history) >= 2
                 else prev.pose.copy(), frame)
             try:
                 with one_blas_thread():

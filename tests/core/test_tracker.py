@@ -580,3 +580,21 @@ def test_a_lost_limb_is_turned_back_where_the_key_frames_pixels_bear_it_out_in_e
     frames = [[render(sk, pose, c, noise=0.01, seed=i) for i in range(3)] for c in range(3)]
     res = Tracker(sk, frames, CALIBRATED).track_frame(lost, 1, pose, 0, lost, 2)
     assert _limb_errors(sk, res.pose, pose).max() < 2.0
+
+
+def test_a_limb_the_search_turned_is_predicted_where_it_was_on_the_next_frame(body):
+    """The body holds an arm out and stands still, but between the first two frames the arm
+    jumps 50 degrees and stays there. The limb search turns it onto the second frame's arm;
+    that step is the error it took out, not motion, and the third frame's prediction holds
+    the arm where the second left it (carried on, it threw the arm 50 degrees off the other
+    way, for the search to fetch back again)."""
+    sk, rest = body
+    pose = _swung(sk, rest, "RightShoulder", -60, 1)
+    jumped = _swung(sk, pose, "RightShoulder", 50, 1)
+    frames = [[render(sk, p, c, noise=0.01, seed=i) for i, p in enumerate(
+        [pose, jumped, jumped, jumped])] for c in range(3)]
+    results = list(Tracker(sk, frames, CALIBRATED).iter_track(pose, [0, 1, 2, 3]))
+    assert "RightShoulder" in results[1].searched
+    assert _limb_errors(sk, results[1].pose, jumped).max() < 2.0
+    assert results[2].searched == [] and results[3].searched == []
+    assert max(_limb_errors(sk, r.pose, jumped).max() for r in results[2:]) < 2.0
