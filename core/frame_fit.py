@@ -262,17 +262,17 @@ class FrameFit:
                    ) -> tuple[BodyPose, list[str]]:
         """``est`` with the turns of ``searched`` that the pixels bear out, and the joints
         so turned where two or more views bore the turn out (``FrameResult.searched``): a
-        limb's turn is
-        kept only when, in every view that sees the limb, its pixels of the earlier frames
-        match the new image clearly better turned than not (``_clearly_lower``); else the
-        limb keeps its predicted motion. The silhouette proposes, brightness decides: an
-        outline alone also fits shadows, clutter and the gaps between other limbs. Where
-        two or more views see the limb, a view may bear the turn out by the key frame's
-        pixels alone: the earlier frame's pixels of a limb that was already off are what it
-        wrongly covered, and they hold it there; the key frame's are the user's pose. One
-        view's key pixels alone are not enough (a limb's shading changes as it turns under
-        a hard light). A limb no view's earlier pixels show (it was hidden) has only its
-        outline to go by, and the search's own test stands."""
+        limb's turn is kept only when, in every view that sees the limb, its pixels of the
+        earlier frames match the new image clearly better turned than not
+        (``_clearly_lower``); else the limb keeps its predicted motion. The silhouette
+        proposes, brightness decides: an outline alone also fits shadows, clutter and the
+        gaps between other limbs. Where two or more views see the limb, a view may bear the
+        turn out by the key frame's pixels alone: the earlier frame's pixels of a limb that
+        was already off are what it wrongly covered, and they hold it there; the key
+        frame's are the user's pose. One view's key pixels alone are not enough (a limb's
+        shading changes as it turns under a hard light). A limb no view's earlier pixels
+        show (it was hidden) has only its outline to go by, and the search's own test
+        stands."""
         kin = Kinematics(self.skeleton, est)
         base = self.sample(est, kin, sets, levels, level)
         moved = self.skeleton.moved_by()
