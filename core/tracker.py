@@ -185,8 +185,7 @@ class Tracker(FrameFit):
         self._cue.reset()  # learned from it
         self.notes = []
         blind = depth_blind_joints(self.given_skeleton, initial)
-        side_on = bool(blind) and self.settings.side_on
-        self.hold_turn_in_depth = side_on
+        self.hold_turn_in_depth = bool(blind) and self.settings.side_on  # tracked side-on
         if self.settings.side_on:
             self._use(side_on_skeleton(self.given_skeleton, initial))
             if blind:
@@ -242,7 +241,7 @@ class Tracker(FrameFit):
                     )
             residuals.append(res.residual)
             if not res.diverged:
-                if side_on:
+                if self.hold_turn_in_depth:
                     res.turned = turned_from(key, res.pose)
                 self._learn_backdrops(res)
             self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
