@@ -71,8 +71,9 @@ def apply_update(
         new.root_position = pose.root_position + dv  # rotation is about the root itself
     else:
         for c, view in enumerate(pose.views):
-            ds, dv1, dv2 = delta[6 * c : 6 * c + 3]
-            E = se3.exp_so3(delta[ROOT_PARAMS * c :][ROOT_TURN])
+            block = delta[ROOT_PARAMS * c : ROOT_PARAMS * (c + 1)]  # this view's root
+            ds, dv1, dv2 = block[:3]
+            E = se3.exp_so3(block[ROOT_TURN])
             P = view.pose
             q_r = P.apply(np.asarray(pose.root_position, dtype=float))
             s_new = P.s * (1 + ds)
