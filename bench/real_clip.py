@@ -96,6 +96,14 @@ def triangulate(cams, pixels: np.ndarray) -> np.ndarray:
     return X[:3] / X[3]
 
 
+def ideal_points(cams, landmarks: np.ndarray, frame: int) -> dict[str, np.ndarray]:
+    """Each scored point's landmark on ``frame`` in every view (views, 2), undistorted
+    through that view's lens (visible or not)."""
+    return {k: np.array([undistort_points(landmarks[c, frame, i][None], cam.camera.K,
+                                          cam.dist)[0] for c, cam in enumerate(cams)])
+            for k, i in POINTS.items()}
+
+
 def guess_pose(sk: Skeleton, cams, ideal: dict[str, np.ndarray]) -> tuple:
     """A first guess of the template's pose from the landmarks (views, 2) of both hips and
     shoulders: the root between the hips, upright along the calibration's z, facing away
@@ -226,10 +234,7 @@ def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarr
     job, the fit's log, seconds tracking, the report)."""
     work = WORK if start == 0 else WORK / f"from_{start}"
     work.mkdir(exist_ok=True)
-    ideal = {k: np.array([undistort_points(landmarks[c, start, i][None], cam.camera.K,
-                                           cam.dist)[0] for c, cam in enumerate(cams)])
-             for k, i in POINTS.items()}
-    R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal)
+    R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal_points(cams, landmarks, start))
     write_bvh(template_bvh(sk).with_motion(R0[None], root0[None]), work / "guess.bvh")
     views = [{"camera": {"calibration": str(DATA / "Calib.qca.txt"), "name": c.name}}
              for c in cams]

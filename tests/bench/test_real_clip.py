@@ -35,12 +35,9 @@ def test_each_frame_fitted_to_its_landmarks_finds_the_pose_they_came_from():
     sk = human_template(lower_back=True)
     cams = read_calibration(real_clip.DATA / "Calib.qca.txt")
     views = [c.camera for c in cams]
-    ideal = {}  # the clip's first frame's hips and shoulders place the body among the cameras
+    # the clip's first frame's hips and shoulders place the body among the cameras
     lm = np.load(real_clip.DATA / "mediapipe_landmarks.npz")
-    for k in ("LeftHip", "RightHip", "LeftShoulder", "RightShoulder"):
-        ideal[k] = np.array([real_clip.undistort_points(
-            lm["xy"][c, 0, real_clip.POINTS[k]][None].astype(float), cam.camera.K, cam.dist)[0]
-            for c, cam in enumerate(cams)])
+    ideal = real_clip.ideal_points(cams, lm["xy"].astype(float), 0)
     R0, root0 = real_clip.guess_pose(sk, views, ideal)
     rng = np.random.default_rng(3)
     truth, start = [], []
