@@ -271,8 +271,9 @@ class FrameFit:
         was already off are what it wrongly covered, and they hold it there; the key
         frame's are the user's pose. One view's key pixels alone are not enough (a limb's
         shading changes as it turns under a hard light). A limb no view's earlier pixels
-        show (it was hidden) has only its outline to go by, and the search's own test
-        stands."""
+        show (it was hidden) is not turned: its outline alone fits a shadow, or foreground
+        another limb left uncovered, as well as the limb, and what the footage does not show
+        is held."""
         kin = Kinematics(self.skeleton, est)
         base = self.sample(est, kin, sets, levels, level)
         moved = self.skeleton.moved_by()
@@ -302,7 +303,7 @@ class FrameFit:
                 key = both & keys[c][on]
                 vouched += bool(key.sum() >= MIN_LIMB_POINTS
                                 and _clearly_lower(new[key], old[key]))
-            if clear == seen or (seen > 1 and vouched == seen):
+            if seen and (clear == seen or (seen > 1 and vouched == seen)):
                 out = cand
                 if seen > 1:
                     kept += [self.skeleton.names[j] for j, _, _ in limb.dofs

@@ -386,7 +386,8 @@ def test_side_on_joints_turn_in_the_image_plane_and_keep_every_joint_at_its_dept
 
 def test_one_view_tracked_side_on_follows_the_limbs_in_the_image(body):
     """Seen from the side, the hips and the neck turned in the image plane: side-on, the one
-    view's track puts every joint back on its image, and its note says how it tracked."""
+    view's track puts every joint back on its image (the far leg too, which comes out from
+    behind the near one), and its note says how it tracked."""
     sk, pose = body
     side = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=90)])
     flat = side_on_skeleton(sk, side)
@@ -403,7 +404,9 @@ def test_one_view_tracked_side_on_follows_the_limbs_in_the_image(body):
         return p.views[0].project(sk.world_positions(p.rotations, p.root_position))
 
     assert np.abs(joint_pixels(moved) - joint_pixels(side)).max() > 15
-    assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 1.5  # measured 0.85
+    # measured 2.09: the left leg, hidden behind the right one on the first frame, is not
+    # turned by the limb search (no pixel of it was seen) but followed by the steps
+    assert np.abs(joint_pixels(est) - joint_pixels(moved)).max() < 2.5
     assert len(res.notes) == 1 and res.notes[0].startswith("side-on: ")
     assert all(n in res.notes[0] for n in ["LeftShoulder", "RightHip", "Neck"])
 
@@ -598,3 +601,25 @@ def test_a_limb_the_search_turned_is_predicted_where_it_was_on_the_next_frame(bo
     assert _limb_errors(sk, results[1].pose, jumped).max() < 2.0
     assert results[2].searched == [] and results[3].searched == []
     assert max(_limb_errors(sk, r.pose, jumped).max() for r in results[2:]) < 2.0
+
+
+def test_a_limb_no_view_showed_is_not_turned_onto_an_outline_alone(body):
+    """Seen from the side, the far arm hangs behind the trunk: no pixel of it is seen. On the
+    next frame a shadow falls beside the trunk where that arm, swung forward, would be. The
+    outline alone fits the shadow as well as an arm, and no pixel of the arm says which it
+    is: the arm is held where it was (turned onto the outline, it moved 39 pixels)."""
+    sk, rest = body
+    side = BodyPose(rest.rotations, rest.root_position, [side_view(yaw_deg=90)])
+    first = render(sk, side, 0)
+    swung = render(sk, _swung(sk, side, "LeftShoulder", 60, 2), 0)
+    shadow = (np.abs(swung - first) > 1e-6) & (first == first[0, 0])  # off the body only
+    nxt = render(sk, side, 0, noise=0.01)
+    nxt[shadow] = 0.05
+    res = track(Tracker(sk, [[first, nxt]], CALIBRATED, TrackerSettings(side_on=True)), side,
+                [0, 1])
+    assert res.frames[1].flagged["LeftShoulder"] == "unseen"
+
+    def joint_pixels(p: BodyPose) -> np.ndarray:
+        return p.views[0].project(sk.world_positions(p.rotations, p.root_position))
+
+    assert np.abs(joint_pixels(res.frames[1].pose) - joint_pixels(side)).max() < 3.0
