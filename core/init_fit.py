@@ -162,7 +162,7 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     bones_turned = _turned_bones(sk, joints)
     R, root, offsets, views, factors = unpack(sol.x)
     fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites,
-                      limits=sk.limits)
+                      limits=sk.limits, hinge_zero=sk.hinge_zero)
     fitted.blobs = fitted.default_blobs()
     n_clicks = sum(len(v) for v in clicks)
     rms = float(np.sqrt(np.sum(sol.fun[:2 * n_clicks] ** 2) / max(n_clicks, 1)))

@@ -175,7 +175,7 @@ def moved_joint(sk: Skeleton, joint: int, shift: np.ndarray, axis: np.ndarray | 
     if axis is not None:
         axes[joint] = axis / np.linalg.norm(axis)
     return Skeleton(list(sk.names), sk.parents.copy(), offsets, list(sk.kinds), axes, ends,
-                    sk.blobs, sk.limits.copy())
+                    sk.blobs, sk.limits.copy(), sk.hinge_zero.copy())
 
 
 def carried_pose(old: Skeleton, new: Skeleton, pose: BodyPose) -> BodyPose:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import se3
 from .linearize import Kinematics
 from .pose import BodyPose
 from .search import SIDE_ON
@@ -42,21 +43,54 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
 
 def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     """``skeleton`` with every joint ``depth_blind_joints`` names at ``pose`` a hinge about
-    the line of sight there (its axis in the joint's frame, its angle free): the paper's body
-    for one camera. ``skeleton`` itself when the views look different ways."""
+    the line of sight there (its axis in the joint's frame, its angle 0 at ``pose``): the
+    paper's body for one camera. A limited hinge so remade keeps the image-plane angles its
+    own range reaches from ``pose`` (``image_range``): an elbow seen obliquely still does
+    not bend backward. ``skeleton`` itself when the views look different ways."""
     blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose)]
     if not blind:
         return skeleton
     frames = Kinematics(skeleton, pose).frames
     kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
+    zero = skeleton.hinge_zero.copy()
+    sight = pose.views[0].orientation[2]
     for j in blind:
+        limits[j] = (image_range(skeleton, j, frames, pose.rotations[j], sight)
+                     if skeleton.kinds[j] == HINGE and np.any(np.isfinite(limits[j]))
+                     else (-np.inf, np.inf))
         kinds[j] = HINGE
-        axes[j] = frames[j, :3, :3].T @ pose.views[0].orientation[2]
-        limits[j] = (-np.inf, np.inf)
+        axes[j] = frames[j, :3, :3].T @ sight
+        zero[j] = pose.rotations[j]
     out = Skeleton(skeleton.names, skeleton.parents, skeleton.offsets, kinds, axes,
-                   skeleton.end_sites, limits=limits)
+                   skeleton.end_sites, limits=limits, hinge_zero=zero)
     out.blobs = skeleton.blobs
     return out
+
+
+def image_range(skeleton: Skeleton, j: int, frames: np.ndarray, rotation: np.ndarray,
+                sight: np.ndarray) -> tuple[float, float]:
+    """The turns (radians) about the line of sight ``sight`` (3,) that limited hinge j's
+    bone, seen along it, makes as the hinge sweeps its range from ``rotation`` (joints'
+    world ``frames`` (J, 4, 4) at that pose): (-inf, inf) where the sweep passes near the
+    line of sight, whose image angle then takes any value."""
+    children = np.flatnonzero(skeleton.parents == j)
+    if len(children):
+        bone = skeleton.offsets[children].mean(axis=0)
+    elif skeleton.end_sites[j]:
+        bone = np.asarray(skeleton.end_sites[j][0], float)
+    else:
+        return -np.inf, np.inf
+    lo, hi = skeleton.hinge_turns(j, rotation)
+    turns = np.linspace(min(lo, 0.0), max(hi, 0.0), 181)
+    axis = np.asarray(skeleton.axes[j], float)
+    dirs = np.array([frames[j, :3, :3] @ se3.exp_so3(axis * t) @ bone for t in turns])
+    across = dirs - np.outer(dirs @ sight, sight)
+    if np.min(np.linalg.norm(across, axis=1)) < 0.2 * np.linalg.norm(bone):
+        return -np.inf, np.inf
+    k = np.argmin(np.abs(turns))  # the bone at ``rotation``
+    angle = np.unwrap(np.arctan2(np.cross(across[k], across) @ sight, across @ across[k]))
+    angle -= angle[k]
+    return float(angle.min()), float(angle.max())
 
 
 def out_of_side_on(turned: float | None) -> bool:

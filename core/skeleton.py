@@ -51,6 +51,7 @@ class Skeleton:
     end_sites: list[list[np.ndarray]] = field(default_factory=list)
     blobs: list[Ellipsoid] = field(default_factory=list)
     limits: np.ndarray | None = None  # (J, 2) hinge angle range, radians (-inf, inf: free)
+    hinge_zero: np.ndarray | None = None  # (J, 3, 3) local rotation where a hinge's angle is 0
 
     def __post_init__(self):
         J = len(self.names)
@@ -62,6 +63,8 @@ class Skeleton:
             self.axes = np.tile([1.0, 0.0, 0.0], (J, 1))
         if self.limits is None:
             self.limits = np.tile([-np.inf, np.inf], (J, 1))
+        if self.hinge_zero is None:
+            self.hinge_zero = np.tile(np.eye(3), (J, 1, 1))
         if not self.end_sites:
             self.end_sites = [[] for _ in range(J)]
         for j, p in enumerate(self.parents):
@@ -141,9 +144,10 @@ class Skeleton:
         return np.array(joints, dtype=int), np.array(axes, dtype=float).reshape(-1, 3)
 
     def hinge_angle(self, j: int, rotation: np.ndarray) -> float:
-        """Hinge j's angle in a local rotation: its rotation vector along the axis (radians;
-        0 at the BVH's rest pose), the quantity ``limits`` bound."""
-        return float(se3.log_so3(rotation) @ self.axes[j])
+        """Hinge j's angle in a local rotation: the rotation vector from ``hinge_zero`` (the
+        BVH's rest pose, unless side-on made the hinge) along the axis, radians: the
+        quantity ``limits`` bound."""
+        return float(se3.log_so3(self.hinge_zero[j].T @ rotation) @ self.axes[j])
 
     def hinge_turns(self, j: int, rotation: np.ndarray) -> tuple[float, float]:
         """The turns (radians, from ``rotation``) that hinge j may make: those that end

@@ -367,8 +367,8 @@ def test_a_note_names_the_joints_that_turn_in_depth_when_the_views_share_a_line_
 
 def test_side_on_joints_turn_in_the_image_plane_and_keep_every_joint_at_its_depth(body):
     """One view from the front: every tracked joint could turn in depth, and side-on each
-    becomes a hinge about the line of sight (limits dropped); any turns then move joints in
-    the image only. Views from three sides leave the skeleton as it is."""
+    becomes a hinge about the line of sight (free, as the fixture's joints are); any turns
+    then move joints in the image only. Views from three sides leave the skeleton as it is."""
     sk, pose = body
     front = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=0)])
     flat = side_on_skeleton(sk, front)
@@ -386,6 +386,46 @@ def test_side_on_joints_turn_in_the_image_plane_and_keep_every_joint_at_its_dept
     moved = (flat.world_positions(turned, pose.root_position)
              - flat.world_positions(pose.rotations, pose.root_position))
     assert np.abs(moved @ sight).max() < 1e-12 and np.linalg.norm(moved, axis=1).max() > 0.1
+
+
+def test_side_on_keeps_a_limited_hinge_within_the_image_angles_its_range_reaches():
+    """Seen 45 degrees off the elbows' axes, side-on remakes each elbow as a hinge about the
+    line of sight whose limits are the image angles the elbow's own range (-160 to 0 degrees)
+    reaches from the first pose: turned to either limit, the forearm lies in the image where
+    the elbow's range ends (found by sweeping the elbow itself, wrist projected), so it
+    cannot bend backward there. From the front the sweep passes through the line of sight
+    and the remade hinge is free."""
+    sk = human_template()
+    j = sk.index("LeftElbow")
+    rest = np.tile(np.eye(3), (sk.n_joints, 1, 1))
+    rest[j] = se3.exp_so3(np.radians([-30.0, 0, 0]))
+
+    def forearm_angle(view, rotations):
+        M = sk.joint_frames(rotations, sk.rest_positions[0])[j]
+        ends = np.array([M[:3, 3], M[:3, :3] @ sk.end_sites[j][0] + M[:3, 3]])
+        d = np.diff(view.project(ends), axis=0)[0]  # elbow to hand, in the image
+        return np.arctan2(d[1], d[0])
+
+    oblique = BodyPose(rest, sk.rest_positions[0].copy(), [side_view(yaw_deg=45)])
+    flat = side_on_skeleton(sk, oblique)
+    assert flat.kinds[j] == HINGE and abs(flat.hinge_angle(j, rest[j])) < 1e-12
+    view, start = oblique.views[0], forearm_angle(oblique.views[0], rest)
+    swept = []
+    for bend in np.radians(np.linspace(-160, 0, 321)):
+        R = rest.copy()
+        R[j] = se3.exp_so3(np.array([bend, 0, 0]))
+        swept.append(forearm_angle(view, R))
+    swept = np.unwrap(np.array(swept) - start)
+    swept -= swept[np.argmin(np.abs(np.linspace(-160, 0, 321) + 30))]
+    ends = []
+    for limit in flat.limits[j]:
+        R = rest.copy()
+        R[j] = rest[j] @ se3.exp_so3(flat.axes[j] * limit)
+        ends.append(np.angle(np.exp(1j * (forearm_angle(view, R) - start))))
+    assert np.degrees(np.ptp(swept)) > 60  # a real range, well short of a full turn
+    assert np.allclose(np.sort(ends), [swept.min(), swept.max()], atol=np.radians(1))
+    front = BodyPose(rest, sk.rest_positions[0].copy(), [side_view(yaw_deg=0)])
+    assert np.all(np.isinf(side_on_skeleton(sk, front).limits[j]))
 
 
 def test_one_view_tracked_side_on_follows_the_limbs_in_the_image(body):
