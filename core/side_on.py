@@ -20,6 +20,9 @@ ONE_LINE_OF_SIGHT = np.cos(np.radians(15))  # views this close in direction see 
 # longer turn in the image plane: the angle the limb search allows a hinge axis off the view
 OUT_OF_SIDE_ON_DEG = float(np.degrees(np.arccos(SIDE_ON)))
 BODY, TURNED = "body", "turned"  # the flag of a frame whose body turned out of side-on
+# a bone seen shorter than this share of its length points nearly along the line of sight:
+# its image angle is then anyone's, and a hinge whose range passes there is left free
+FORESHORTENED = 0.2
 
 
 def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
@@ -80,12 +83,11 @@ def image_range(skeleton: Skeleton, j: int, frames: np.ndarray, rotation: np.nda
         bone = np.asarray(skeleton.end_sites[j][0], float)
     else:
         return -np.inf, np.inf
-    lo, hi = skeleton.hinge_turns(j, rotation)
-    turns = np.linspace(min(lo, 0.0), max(hi, 0.0), 181)
+    turns = np.linspace(*skeleton.hinge_turns(j, rotation), 181)  # a degree apart or less
     axis = np.asarray(skeleton.axes[j], float)
     dirs = np.array([frames[j, :3, :3] @ se3.exp_so3(axis * t) @ bone for t in turns])
     across = dirs - np.outer(dirs @ sight, sight)
-    if np.min(np.linalg.norm(across, axis=1)) < 0.2 * np.linalg.norm(bone):
+    if np.min(np.linalg.norm(across, axis=1)) < FORESHORTENED * np.linalg.norm(bone):
         return -np.inf, np.inf
     k = np.argmin(np.abs(turns))  # the bone at ``rotation``
     angle = np.unwrap(np.arctan2(np.cross(across[k], across) @ sight, across @ across[k]))
