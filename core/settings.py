@@ -59,7 +59,8 @@ class TrackerSettings:
                                   "the full image")
     side_on: bool = _knob(True, "Where every view looks along one line (one view): track "
                           "every joint that could turn toward or away from the camera as a "
-                          "hinge about the line of sight at the first frame, as the paper "
+                          "hinge about the line of sight at the first frame (a limited "
+                          "hinge keeping the image angles its range reaches), as the paper "
                           "does with one camera, and turn the body itself only about that "
                           "line: the limbs follow the footage in the image, and what the "
                           "footage does not show in depth is held, not guessed (off: those "
