@@ -50,7 +50,7 @@ from .search import LimbSearch
 from .sequence import ImageSequence
 from .settings import TrackerSettings
 from .side_on import BODY, TURNED, out_of_side_on
-from .skeleton import HINGE, Skeleton
+from .skeleton import Skeleton
 from .solver import (
     NormalEquations,
     mixture_cost,
@@ -197,8 +197,7 @@ class FrameFit:
         thin = np.full(skeleton.n_joints, np.inf)
         np.minimum.at(thin, self._blobs.joint, self._blobs.radii[:, 1:].min(axis=1))
         self.dof_thickness = thin[self._dof_joint]
-        self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.kinds[j] == HINGE
-                         and np.any(np.isfinite(skeleton.limits[j]))]
+        self._limited = [k for k, j in enumerate(self._dof_joint) if skeleton.limited_hinge(j)]
         self._limbs = Limbs(skeleton, self._blobs)
         self._search = LimbSearch(skeleton, self.settings.limb_search, self._limbs)
 

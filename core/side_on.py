@@ -59,7 +59,7 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
     sight = pose.views[0].orientation[2]
     for j in blind:
         limits[j] = (image_range(skeleton, j, frames, pose.rotations[j], sight)
-                     if skeleton.kinds[j] == HINGE and np.any(np.isfinite(limits[j]))
+                     if skeleton.limited_hinge(j)
                      else (-np.inf, np.inf))
         kinds[j] = HINGE
         axes[j] = frames[j, :3, :3].T @ sight

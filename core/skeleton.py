@@ -143,6 +143,10 @@ class Skeleton:
                 axes.append(a / np.linalg.norm(a))
         return np.array(joints, dtype=int), np.array(axes, dtype=float).reshape(-1, 3)
 
+    def limited_hinge(self, j: int) -> bool:
+        """Whether joint j is a hinge with a finite limit on either side."""
+        return self.kinds[j] == HINGE and bool(np.any(np.isfinite(self.limits[j])))
+
     def hinge_angle(self, j: int, rotation: np.ndarray) -> float:
         """Hinge j's angle in a local rotation: the rotation vector from ``hinge_zero`` (the
         BVH's rest pose, unless side-on made the hinge) along the axis, radians: the

@@ -410,13 +410,14 @@ def test_side_on_keeps_a_limited_hinge_within_the_image_angles_its_range_reaches
     flat = side_on_skeleton(sk, oblique)
     assert flat.kinds[j] == HINGE and abs(flat.hinge_angle(j, rest[j])) < 1e-12
     view, start = oblique.views[0], forearm_angle(oblique.views[0], rest)
+    bends = np.linspace(-160, 0, 321)  # the elbow's own range, degrees
     swept = []
-    for bend in np.radians(np.linspace(-160, 0, 321)):
+    for bend in np.radians(bends):
         R = rest.copy()
         R[j] = se3.exp_so3(np.array([bend, 0, 0]))
         swept.append(forearm_angle(view, R))
     swept = np.unwrap(np.array(swept) - start)
-    swept -= swept[np.argmin(np.abs(np.linspace(-160, 0, 321) + 30))]
+    swept -= swept[np.argmin(np.abs(bends + 30))]  # from the first pose's bend
     ends = []
     for limit in flat.limits[j]:
         R = rest.copy()
