@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .camera import Camera
+from .linearize import Kinematics
 from .raycast import BlobStack
 from .skeleton import BALL, HINGE, Skeleton
 
@@ -88,6 +90,9 @@ class Limbs:
         self.axis_joint = np.repeat(blob_joint[mine], len(t))
         self.axis_ref = (blobs.centre[mine, None] + axis[:, None] * t[:, None]).reshape(-1, 3)
         self.axis_limb = np.repeat(self.of_blob[mine], len(t))
+        # each point's blob's thickness: twice the mean of its two shorter radii, world units
+        self.axis_thickness = np.repeat(2 * np.sort(blobs.radii[mine], axis=1)[:, :2].mean(1),
+                                        len(t))
 
     def __len__(self) -> int:
         return len(self.names)
@@ -111,6 +116,27 @@ class Limbs:
             hit = np.bincount(self.axis_limb[use], weights=axis_on[use], minlength=L)
             agree *= np.where(area > 0, hit / np.maximum(area, 1), 1.0)
         return agree
+
+    def bone_off_body(self, kin: Kinematics, views: Sequence[Camera],
+                      to_body: Sequence[np.ndarray | None]) -> np.ndarray:
+        """(L, V): per limb and view, the share of the limb's bone points at the pose ``kin``
+        that lie farther from any pixel that may be the body than their blob is thick: where
+        the limb cannot be, whatever holes the body's silhouette has. ``to_body``: per view,
+        its ``silhouette.distance_to_body`` map on the level of ``views``, or None. NaN
+        where a view has no map or shows none of the limb's bone."""
+        axis = kin.world_points(self.axis_joint, self.axis_ref)
+        out = np.full((len(self), len(views)), np.nan)
+        for c, (view, far) in enumerate(zip(views, to_body)):
+            if far is None:
+                continue
+            px = np.rint(view.project(axis)).astype(int)
+            inside = ((px >= 0) & (px < (far.shape[1], far.shape[0]))).all(axis=1)
+            thick = self.axis_thickness[inside] * view.scale_at(axis[inside].mean(axis=0))
+            off = far[px[inside, 1], px[inside, 0]] > thick
+            area = np.bincount(self.axis_limb[inside], minlength=len(self))
+            hit = np.bincount(self.axis_limb[inside], weights=off, minlength=len(self))
+            out[:, c] = np.where(area > 0, hit / np.maximum(area, 1), np.nan)
+        return out
 
     def checks(self, per_view: Sequence[np.ndarray]) -> dict[str, LimbCheck]:
         """Each limb's check from its agreement in every view (``view_agreement``'s)."""

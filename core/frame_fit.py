@@ -15,7 +15,8 @@ silhouette (``silhouette``): chamfer pulls in both directions whose reach is a l
 length, not a blob's width, so that a fast limb is caught and a lost one found again; and
 before refining, each limb is searched over a grid of turns against the silhouette
 (``core.search``), a turn kept where every view's pixels bear it out (the earlier frame's,
-or in two views or more the key frame's). The finished frame's limbs are checked against
+or in two views or more the key frame's), or where two or more views' backdrops show that
+the limb cannot be where it is and can be where it turned. The finished frame's limbs are checked against
 every view (``core.confidence``). Sizes in pixels are meant for a body about
 ``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that view's
 pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads every
@@ -243,70 +244,114 @@ class FrameFit:
             key.root_position)
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
-                      ) -> tuple[BodyPose, list[str]]:
+                      ) -> tuple[BodyPose, list[str], tuple]:
         """``est`` with every limb turned to where the silhouette wants it (``LimbSearch``),
-        on the level below full resolution, and the joints that turned."""
+        on the level below full resolution, the joints that turned, and the views the search
+        read with each one's ``silhouette.distance_to_body`` map (None for a view it left
+        out)."""
         if self.settings.silhouette <= 0:
-            return est, []
+            return est, [], ()
         self._start_cue(key, key_frame)
         lvs = self.scales.view_levels(self.scales.search_level())
         fgs = [sil.at_level(self._cue.foreground(c, frame), lv) if self._cue.has(c) else None
                for c, lv in enumerate(lvs)]
         if all(f is None for f in fgs):
-            return est, []
-        return self._search.run(est, [v.at_level(lv) for v, lv in zip(est.views, lvs)], fgs)
+            return est, [], ()
+        views = [v.at_level(lv) for v, lv in zip(est.views, lvs)]
+        fgs = self._search.usable(est, views, fgs)
+        to_body = [None if fg is None else sil.distance_to_body(fg) for fg in fgs]
+        return *self._search.run(est, views, fgs), (views, to_body)
 
-    def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
-                   sets: list[PointSet], levels: list, level: int
-                   ) -> tuple[BodyPose, list[str]]:
-        """``est`` with the turns of ``searched`` that the pixels bear out, and the joints
-        so turned where two or more views bore the turn out (``FrameResult.searched``): a
-        limb's turn is kept only when, in every view that sees the limb, its pixels of the
-        earlier frames match the new image clearly better turned than not
-        (``_clearly_lower``); else the limb keeps its predicted motion. The silhouette
-        proposes, brightness decides: an outline alone also fits shadows, clutter and the
-        gaps between other limbs. Where two or more views see the limb, a view may bear the
-        turn out by the key frame's pixels alone: the earlier frame's pixels of a limb that
-        was already off are what it wrongly covered, and they hold it there; the key
-        frame's are the user's pose. One view's key pixels alone are not enough (a limb's
-        shading changes as it turns under a hard light). A limb no view's earlier pixels
-        show (it was hidden) is not turned: its outline alone fits a shadow, or foreground
-        another limb left uncovered, as well as the limb, and what the footage does not show
-        is held."""
-        kin = Kinematics(self.skeleton, est)
-        base = self.sample(est, kin, sets, levels, level)
+    def _refuted_chain(self, est: BodyPose, searched: BodyPose, limb, backdrops: tuple
+                       ) -> tuple[BodyPose, list] | None:
+        """``est`` with the search's turns of ``limb`` and of the limbs below it (which the
+        search placed for it), and their degrees of freedom, where the backdrops refute
+        those limbs at ``est`` and bear them out so turned; else None. Of two or more views
+        with a backdrop (``backdrops``: ``_search_limbs``' views and maps), one must show a
+        point of their bones where the body cannot be now (``Limbs.bone_off_body``), and
+        none one there once turned. A still backdrop's pixel is a plain negative: the body
+        is not there. A joint several limbs hang from (the trunk's) is not a limb's."""
+        if not backdrops:
+            return None
+        moved = self.skeleton.moved_by()
+        chain = [lb for lb in self._search.limbs if moved[lb.joint, limb.joint]]
+        if not all(moved[a.joint, b.joint] or moved[b.joint, a.joint]
+                   for a in chain for b in chain):
+            return None
+        turned = est.copy()
+        for lb in chain:
+            for j, _, _ in lb.dofs:
+                turned.rotations[j] = searched.rotations[j]
+        rows = [self._limbs.names.index(self.skeleton.names[lb.joint]) for lb in chain]
+        now, then = (self._limbs.bone_off_body(Kinematics(self.skeleton, p), *backdrops)[rows]
+                     for p in (est, turned))
+        have = np.all(~np.isnan(now) & ~np.isnan(then), axis=0)
+        if have.sum() >= 2 and np.all(then[:, have] == 0) and np.any(now[:, have] > 0):
+            return turned, [d for lb in chain for d in lb.dofs]
+        return None
+
+    def _pixels_bear_out(self, base: _Samples, cand: BodyPose, limb, sets: list[PointSet],
+                         levels: list, level: int) -> int:
+        """How many views see ``limb`` where their pixels bear out its turn to ``cand``
+        (from ``base``'s pose), else 0 (``_evidenced``)."""
+        trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
+                            base.sigmas)
         moved = self.skeleton.moved_by()
         bounds = np.cumsum([0] + [len(ps.value) for ps in sets])
-        keys = [ps.key_points() for ps in sets]
+        seen = clear = vouched = 0
+        for c, ps in enumerate(sets):
+            on = moved[ps.seg_joint, limb.joint]
+            old, new = (x[bounds[c]:bounds[c + 1]][on] for x in (base.costs, trial.costs))
+            both = ~np.isnan(old) & ~np.isnan(new)
+            if both.sum() < MIN_LIMB_POINTS:
+                continue  # this view does not see the limb (hidden, or too small)
+            seen += 1
+            if _clearly_lower(new[both], old[both]):
+                clear += 1
+                vouched += 1
+                continue
+            key = both & ps.key_points()[on]
+            vouched += bool(key.sum() >= MIN_LIMB_POINTS
+                            and _clearly_lower(new[key], old[key]))
+        return seen if seen and (clear == seen or (seen > 1 and vouched == seen)) else 0
+
+    def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
+                   sets: list[PointSet], levels: list, level: int, backdrops: tuple = ()
+                   ) -> tuple[BodyPose, list[str]]:
+        """``est`` with the turns of ``searched`` that the footage bears out, and the joints
+        so turned where two or more views bore the turn out (``FrameResult.searched``).
+        Parents first, a limb's turn is kept when the backdrops refute the limb where it is
+        and bear it out turned, with the limbs below it (``_refuted_chain``), or when, in
+        every view that sees the limb, its pixels of the earlier frames match the new image
+        clearly better turned than not (``_clearly_lower``); else the limb keeps its
+        predicted motion. The silhouette proposes, brightness decides: an outline alone also
+        fits shadows, clutter and the gaps between other limbs. But the pixels of a limb
+        already lost are what it wrongly covered, and they hold it there: where a backdrop
+        shows the limb cannot be where it is, the outlines of every view decide. Where two or
+        more views see the limb, a view may bear the turn out by the key frame's pixels
+        alone (they are the user's pose); one view's key pixels alone are not enough (a
+        limb's shading changes as it turns under a hard light). A limb no view's earlier
+        pixels show (it was hidden) is not turned by brightness: its outline alone fits a
+        shadow, or foreground another limb left uncovered, as well as the limb, and what
+        the footage does not show is held."""
+        base = self.sample(est, Kinematics(self.skeleton, est), sets, levels, level)
         out, kept = est, []
         for limb in self._search.limbs:
             if self.skeleton.names[limb.joint] not in turned:
                 continue
-            cand = out.copy()
-            for j, _, _ in limb.dofs:
-                cand.rotations[j] = searched.rotations[j]
-            trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
-                                base.sigmas)
-            seen = clear = vouched = 0
-            for c, ps in enumerate(sets):
-                on = moved[ps.seg_joint, limb.joint]
-                old, new = (x[bounds[c]:bounds[c + 1]][on] for x in (base.costs, trial.costs))
-                both = ~np.isnan(old) & ~np.isnan(new)
-                if both.sum() < MIN_LIMB_POINTS:
-                    continue  # this view does not see the limb (hidden, or too small)
-                seen += 1
-                if _clearly_lower(new[both], old[both]):
-                    clear += 1
-                    vouched += 1
+            refuted = self._refuted_chain(out, searched, limb, backdrops)
+            if refuted is not None:
+                out, dofs = refuted
+            else:
+                cand = out.copy()
+                for j, _, _ in limb.dofs:
+                    cand.rotations[j] = searched.rotations[j]
+                seen = self._pixels_bear_out(base, cand, limb, sets, levels, level)
+                if not seen:
                     continue
-                key = both & keys[c][on]
-                vouched += bool(key.sum() >= MIN_LIMB_POINTS
-                                and _clearly_lower(new[key], old[key]))
-            if seen and (clear == seen or (seen > 1 and vouched == seen)):
-                out = cand
-                if seen > 1:
-                    kept += [self.skeleton.names[j] for j, _, _ in limb.dofs
-                             if not np.allclose(cand.rotations[j], est.rotations[j])]
+                out, dofs = cand, limb.dofs if seen > 1 else []
+            kept += [self.skeleton.names[j] for j, _, _ in dofs
+                     if not np.allclose(out.rotations[j], est.rotations[j])]
         return out, kept
 
     def scale_to(self, pose: BodyPose) -> None:
@@ -619,10 +664,10 @@ class FrameFit:
                 sets.append(PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and level == self.scales.search_level():
-                searched, turned = self._search_limbs(est, frame, key, key_frame)
+                searched, turned, backdrops = self._search_limbs(est, frame, key, key_frame)
                 if turned:
                     searched, searched_joints = self._evidenced(est, searched, turned, sets,
-                                                                levels, level)
+                                                                levels, level, backdrops)
                 if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)

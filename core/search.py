@@ -159,8 +159,7 @@ class LimbSearch:
         pose = pose.copy()
         kin = Kinematics(self.sk, pose)
         A, C = blob_frames(self.blobs, kin.segments)
-        fgs = [None if fg is None or self._foreground_share(view, fg, A, C) < MIN_FOREGROUND
-               else fg for view, fg in zip(views, fgs)]
+        fgs = self.usable(pose, views, fgs)
         n_views = sum(fg is not None for fg in fgs)
         turned = []
         for limb in self.limbs if n_views else ():
@@ -180,6 +179,14 @@ class LimbSearch:
                 kin = Kinematics(self.sk, pose)  # the limbs below see it turned
                 A, C = blob_frames(self.blobs, kin.segments)
         return pose, turned
+
+    def usable(self, pose: BodyPose, views: Sequence[Camera],
+               fgs: Sequence[np.ndarray | None]) -> list[np.ndarray | None]:
+        """``fgs`` with None for each view the search leaves out at ``pose``: where under
+        ``MIN_FOREGROUND`` of the body's outline is foreground."""
+        A, C = blob_frames(self.blobs, Kinematics(self.sk, pose).segments)
+        return [None if fg is None or self._foreground_share(view, fg, A, C) < MIN_FOREGROUND
+                else fg for view, fg in zip(views, fgs)]
 
     @staticmethod
     def _foreground_share(view: Camera, fg: np.ndarray, A, C) -> float:

@@ -266,6 +266,13 @@ class Mismatch:
     weight: np.ndarray  # (N,) each pair's weight
 
 
+def distance_to_body(fg: np.ndarray) -> np.ndarray:
+    """Per pixel of a foreground map (H, W), how far (pixels) the nearest pixel that may be
+    the body is: 0 on foreground and unsure pixels, growing over the backdrop."""
+    return cv2.distanceTransform((fg == BACKDROP).astype(np.uint8), cv2.DIST_L2,
+                                 cv2.DIST_MASK_PRECISE)
+
+
 class NearestPixel:
     """Where the nearest pixel of a mask (H, W) is from any pixel: one distance transform,
     made when first asked and then looked up (a level's foreground, against which every

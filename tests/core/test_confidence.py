@@ -6,7 +6,9 @@ import copy
 import numpy as np
 import pytest
 
+from core import silhouette as sil
 from core.confidence import MIN_LIMB_POINTS, UNSEEN, UNSURE, UNSURE_FLAG, Limbs, frame_list
+from core.linearize import Kinematics
 from core.pose import CALIBRATED, BodyPose
 from core.raycast import BlobStack
 from core.settings import TrackerSettings
@@ -77,6 +79,34 @@ def test_a_limbs_bone_runs_along_its_blobs_long_axes(template):
             assert mine.sum() >= 9
             rank = np.linalg.matrix_rank(pts[mine][:9] - stack.centre[b], tol=1e-9)
             assert rank == 1, name
+
+
+def test_a_bone_point_is_off_the_body_where_no_body_pixel_lies_within_its_blobs_thickness(
+        template):
+    """Checked point by point against a brute-force nearest body pixel, on a foreground map
+    whose body pixels (foreground or unsure) are a random half of a box over the image's left
+    half: the limbs on the right lie outside it, those on the left inside, among holes."""
+    sk = template
+    limbs = _limbs(sk)
+    view = side_view(yaw_deg=0)
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                    [view])
+    kin = Kinematics(sk, pose)
+    rng = np.random.default_rng(5)
+    fg = np.full((360, 320), sil.BACKDROP, np.uint8)
+    fg[40:330, 40:150] = rng.choice([sil.FOREGROUND, sil.UNSURE, sil.BACKDROP], (290, 110),
+                                    p=[0.4, 0.1, 0.5])
+    far = sil.distance_to_body(fg)
+    body = np.argwhere(fg != sil.BACKDROP)  # (row, col)
+    got = limbs.bone_off_body(kin, [view, view], [far, None])
+    assert np.all(np.isnan(got[:, 1]))
+    px = np.rint(view.project(kin.world_points(limbs.axis_joint, limbs.axis_ref))).astype(int)
+    for i in range(len(limbs)):
+        mine = np.flatnonzero(limbs.axis_limb == i)
+        off = [np.min(np.hypot(*(body - px[k, ::-1]).T))
+               > limbs.axis_thickness[k] * view.scale_at(None) for k in mine]
+        assert got[i, 0] == pytest.approx(np.mean(off), abs=1e-9)
+    assert 0 < np.nanmax(got[:, 0]) and np.nanmin(got[:, 0]) == 0
 
 
 def test_a_limb_is_as_sure_as_its_worst_seeing_view_and_unseen_when_no_view_sees_it(

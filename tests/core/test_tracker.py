@@ -627,6 +627,24 @@ def test_a_lost_limb_is_turned_back_where_the_key_frames_pixels_bear_it_out_in_e
     assert _limb_errors(sk, res.pose, pose).max() < 2.0
 
 
+@pytest.mark.parametrize("joint, held, off, axis", [("RightShoulder", -60, 50, 1),
+                                                    ("RightHip", -40, 45, 2)])
+def test_a_lost_limb_the_backdrop_refutes_in_a_view_is_turned_back_without_brightness(
+        body, joint, held, off, axis):
+    """As above, but the tracker reads the earlier frame's pixels alone (no key frame): they
+    hold the limb where it was left. In the side view most of its bone now lies on the
+    still backdrop, which the body cannot cover, and the search's turn puts it on the body
+    in all three views: the backdrop's word is enough, and the limb is turned back."""
+    sk, rest = body
+    pose = _swung(sk, rest, joint, held, axis)
+    lost = _swung(sk, pose, joint, off, axis)
+    frames = [[render(sk, pose, c, noise=0.01, seed=i) for i in range(3)] for c in range(3)]
+    tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(key_weight=0.0))
+    res = tracker.track_frame(lost, 1, pose, 0, lost, 2)
+    assert _limb_errors(sk, res.pose, pose).max() < 2.0
+    assert joint in res.searched
+
+
 def test_a_limb_the_search_turned_is_predicted_where_it_was_on_the_next_frame(body):
     """The body holds an arm out and stands still, but between the first two frames the arm
     jumps 50 degrees and stays there. The limb search turns it onto the second frame's arm;
