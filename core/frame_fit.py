@@ -16,8 +16,8 @@ length, not a blob's width, so that a fast limb is caught and a lost one found a
 before refining, each limb is searched over a grid of turns against the silhouette
 (``core.search``), a turn kept where every view's pixels bear it out (the earlier frame's,
 or in two views or more the key frame's), or where two or more views' backdrops show that
-the limb cannot be where it is and can be where it turned. The finished frame's limbs are checked against
-every view (``core.confidence``). Sizes in pixels are meant for a body about
+the limb cannot be where it is and can be where it turned. The finished frame's limbs are
+checked against every view (``core.confidence``). Sizes in pixels are meant for a body about
 ``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that view's
 pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads every
 view where the body is about as large (``auto_scale``, ``core.scales``).

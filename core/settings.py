@@ -70,8 +70,10 @@ class TrackerSettings:
                                "angles against the silhouette and keep the best turn when it "
                                "beats the prediction by this share of the limb's outline, "
                                "and by that again per 45 degrees of turn squared, and every "
-                               "view whose pixels see the limb bears the turn out (0: off). "
-                               "Catches limbs faster than a blob's width a frame")
+                               "view whose pixels see the limb bears the turn out, or two or "
+                               "more views' backdrops show the limb cannot be where it is and "
+                               "can be where it turned (0: off). Catches limbs faster than a "
+                               "blob's width a frame")
 
     def __post_init__(self):
         for name in ("levels", "iterations", "pixel_step"):
