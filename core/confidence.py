@@ -131,6 +131,8 @@ class Limbs:
                 continue
             px = np.rint(view.project(axis)).astype(int)
             inside = ((px >= 0) & (px < (far.shape[1], far.shape[0]))).all(axis=1)
+            if not inside.any():
+                continue
             thick = self.axis_thickness[inside] * view.scale_at(axis[inside].mean(axis=0))
             off = far[px[inside, 1], px[inside, 0]] > thick
             area = np.bincount(self.axis_limb[inside], minlength=len(self))

@@ -260,7 +260,7 @@ class FrameFit:
         views = [v.at_level(lv) for v, lv in zip(est.views, lvs)]
         fgs = self._search.usable(est, views, fgs)
         to_body = [None if fg is None else sil.distance_to_body(fg) for fg in fgs]
-        return *self._search.run(est, views, fgs), (views, to_body)
+        return *self._search.turn(est, views, fgs), (views, to_body)
 
     def _refuted_chain(self, est: BodyPose, searched: BodyPose, limb, backdrops: tuple
                        ) -> tuple[BodyPose, list] | None:

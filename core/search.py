@@ -152,14 +152,19 @@ class LimbSearch:
         """The pose with each limb turned to its best place, and the joints that turned.
         ``views`` and ``fgs`` (foreground maps, ``core.silhouette``'s; None for a view
         without one) share one level; a view where under ``MIN_FOREGROUND`` of the body's
-        outline is foreground (of what is not unsure) is left out. With one view left, only
-        hinges whose axis points along that view turn (a limb seen side-on, an animal's):
-        any other turn moves the limb in depth too, and one outline cannot tell a limb
-        turned toward the camera from a shorter one."""
+        outline is foreground (of what is not unsure) is left out (``usable``), and the
+        rest searched (``turn``)."""
+        return self.turn(pose, views, self.usable(pose, views, fgs))
+
+    def turn(self, pose: BodyPose, views: Sequence[Camera], fgs: Sequence[np.ndarray | None]
+             ) -> tuple[BodyPose, list[str]]:
+        """``run`` on the views ``usable`` kept (``fgs`` as it returned them). With one view
+        left, only hinges whose axis points along that view turn (a limb seen side-on, an
+        animal's): any other turn moves the limb in depth too, and one outline cannot tell a
+        limb turned toward the camera from a shorter one."""
         pose = pose.copy()
         kin = Kinematics(self.sk, pose)
         A, C = blob_frames(self.blobs, kin.segments)
-        fgs = self.usable(pose, views, fgs)
         n_views = sum(fg is not None for fg in fgs)
         turned = []
         for limb in self.limbs if n_views else ():
