@@ -74,6 +74,25 @@ def test_a_movie_read_from_two_threads_gives_each_its_own_frame(footage, tmp_pat
         np.testing.assert_array_equal(frame, once[i])
 
 
+def test_a_movie_read_out_of_order_gives_the_frames_decoded_in_order(tmp_path):
+    """Jumps back, short jumps forward (decoded through) and a long one (sought) each give
+    the frame a plain decode from the start gives there."""
+    from core.video import DECODE_AHEAD, VideoFrames
+
+    n = DECODE_AHEAD + 20
+    movie = tmp_path / "count.avi"
+    writer = cv2.VideoWriter(str(movie), cv2.VideoWriter_fourcc(*"MJPG"), 30, (64, 48))
+    rng = np.random.default_rng(7)
+    for _ in range(n):
+        writer.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    writer.release()
+    video = VideoFrames(movie)
+    in_order = [video[i] for i in range(n)]
+    again = VideoFrames(movie)
+    for i in (0, 3, 4, 9, 2, 5, 5 + DECODE_AHEAD, 1, 2 + DECODE_AHEAD + 1, n - 1, 0):
+        np.testing.assert_array_equal(again[i], in_order[i], err_msg=f"frame {i}")
+
+
 def test_grey_footage_has_no_colour(tmp_path):
     """Grey files, and grey pictures stored as colour (three equal channels), have none."""
     img = np.random.default_rng(4).integers(0, 256, (20, 30), dtype=np.uint8)
