@@ -226,7 +226,7 @@ class FrameFit:
             x0, y0 = np.maximum(np.floor((boxes[:, :2].min(0) - margin) / g), 0).astype(int)
             x1 = int(min(np.ceil((boxes[:, 2].max() + margin) / g), -(-shape[1] // g)))
             y1 = int(min(np.ceil((boxes[:, 3].max() + margin) / g), -(-shape[0] // g)))
-            fg = sil.at_level(self._cue.foreground(c, frame), lv)[::g, ::g]
+            fg = self._cue.foreground(c, frame, lv)[::g, ::g]
             crop = fg[y0:max(y1, y0), x0:max(x1, x0)]
             out.append((crop, (x0, y0), sil.NearestPixel(crop == sil.FOREGROUND)))
         return out
@@ -253,7 +253,7 @@ class FrameFit:
             return est, [], ()
         self._start_cue(key, key_frame)
         lvs = self.scales.view_levels(self.scales.search_level())
-        fgs = [sil.at_level(self._cue.foreground(c, frame), lv) if self._cue.has(c) else None
+        fgs = [self._cue.foreground(c, frame, lv) if self._cue.has(c) else None
                for c, lv in enumerate(lvs)]
         if all(f is None for f in fgs):
             return est, [], ()

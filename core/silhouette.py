@@ -239,21 +239,36 @@ def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndar
     return np.linalg.norm(f - scale[:, None] * b, axis=1), scale
 
 
-def at_level(fg: np.ndarray, level: int) -> np.ndarray:
-    """A full-resolution foreground map as one on pyramid level ``level``, made the way the
-    image pyramid is (``cv2.pyrDown``: level pixel i centred on pixel 2i below), so that the
-    map and the level's label maps line up: a level pixel is foreground where most of what
-    it covers is, else unsure where most is unsure."""
-    def down(mask):
-        mask = mask.astype(np.float32)
-        for _ in range(level):
-            mask = cv2.pyrDown(mask)
-        return mask > 0.5
+class LevelMaps:
+    """A full-resolution foreground map (H, W) on any pyramid level, made the way the image
+    pyramid is (``cv2.pyrDown``: level pixel i centred on pixel 2i below), so that the map
+    and the level's label maps line up: a level pixel is foreground where most of what it
+    covers is, else unsure where most is unsure. The blurred shares of each code are kept
+    from one level to the next, so every level of a frame costs one pyramid."""
 
-    out = down(fg == FOREGROUND).astype(np.uint8)
-    if np.any(fg == UNSURE):
-        out[down(fg == UNSURE) & (out == BACKDROP)] = UNSURE
-    return out
+    def __init__(self, fg: np.ndarray):
+        self.fg = fg
+        # per code, its share of each level's pixels (finest first); unsure only if any is
+        self._shares = {code: [(fg == code).astype(np.float32)] for code in (FOREGROUND, UNSURE)
+                        if code == FOREGROUND or np.any(fg == UNSURE)}
+        self._maps: dict[int, np.ndarray] = {}
+
+    def at(self, level: int) -> np.ndarray:
+        """The map on pyramid level ``level`` (0: the full-resolution map's codes)."""
+        if level not in self._maps:
+            for shares in self._shares.values():
+                while len(shares) <= level:
+                    shares.append(cv2.pyrDown(shares[-1]))
+            out = (self._shares[FOREGROUND][level] > 0.5).astype(np.uint8)
+            if UNSURE in self._shares:
+                out[(self._shares[UNSURE][level] > 0.5) & (out == BACKDROP)] = UNSURE
+            self._maps[level] = out
+        return self._maps[level]
+
+
+def at_level(fg: np.ndarray, level: int) -> np.ndarray:
+    """A full-resolution foreground map as one on pyramid level ``level`` (``LevelMaps``)."""
+    return LevelMaps(fg).at(level)
 
 
 @dataclass
@@ -354,7 +369,7 @@ class SilhouetteCue:
         self.plates = list(plates) if plates is not None else [None] * seq.n_views
         # per view; None: not started
         self.backdrops: list[Backdrop | TurningBackdrop | None] | None = None
-        self._foregrounds: dict[tuple[int, int], np.ndarray] = {}  # (view, frame): full res
+        self._foregrounds: dict[tuple[int, int], LevelMaps] = {}  # (view, frame)
 
     def reset(self) -> None:
         """Forget the backdrops (a new key pose, or a new size of the body's pyramids)."""
@@ -420,16 +435,16 @@ class SilhouetteCue:
         """Whether ``view`` has a backdrop (after ``start``)."""
         return self.backdrops is not None and self.backdrops[view] is not None
 
-    def foreground(self, view: int, frame: int) -> np.ndarray:
-        """Full-resolution foreground map of ``frame`` in ``view`` (one that ``has``); only
-        one frame's are kept."""
+    def foreground(self, view: int, frame: int, level: int = 0) -> np.ndarray:
+        """Foreground map of ``frame`` in ``view`` (one that ``has``) on pyramid level
+        ``level`` (``LevelMaps``; 0: full resolution); only one frame's are kept."""
         if (view, frame) not in self._foregrounds:
             self._foregrounds = {k: v for k, v in self._foregrounds.items() if k[1] == frame}
             bd = self.backdrops[view]
             seen = (self.seq.grey(view, frame), self.seq.colour(view, frame))
-            self._foregrounds[view, frame] = bd.foreground(frame, *seen) if isinstance(
-                bd, TurningBackdrop) else bd.foreground(*seen)
-        return self._foregrounds[view, frame]
+            self._foregrounds[view, frame] = LevelMaps(bd.foreground(frame, *seen) if isinstance(
+                bd, TurningBackdrop) else bd.foreground(*seen))
+        return self._foregrounds[view, frame].at(level)
 
     def unseen(self, view: int) -> bool:
         """Whether ``view``'s backdrop can still learn from a tracked frame."""

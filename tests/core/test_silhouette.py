@@ -17,6 +17,7 @@ from core.silhouette import (
     FOREGROUND,
     UNSURE,
     Backdrop,
+    LevelMaps,
     NearestPixel,
     SilhouetteCue,
     at_level,
@@ -185,6 +186,31 @@ def test_a_foreground_map_on_a_coarser_level_keeps_its_codes():
     assert lv[7, 7] == FOREGROUND and lv[7, 17] == UNSURE and lv[1, 12] == BACKDROP
     np.testing.assert_array_equal(at_level(fg == FOREGROUND, 2) == FOREGROUND,
                                   lv == FOREGROUND)
+
+
+def test_a_frames_level_maps_asked_in_any_order_are_each_made_from_full_resolution():
+    """``LevelMaps`` shares the blurred shares between levels; each level's map must be
+    what blurring the full-resolution codes down that many times and taking the majority
+    gives (a map made from a coarser map's codes, not their shares, would differ)."""
+    rng = np.random.default_rng(3)
+    fg = rng.choice([BACKDROP, FOREGROUND, UNSURE], (97, 131), p=[0.5, 0.3, 0.2])
+    fg = cv2.medianBlur(fg.astype(np.uint8), 5)
+
+    def made_afresh(level):
+        out = np.zeros(fg.shape, np.uint8)
+        for code in (FOREGROUND, UNSURE):
+            share = (fg == code).astype(np.float32)
+            for _ in range(level):
+                share = cv2.pyrDown(share)
+            if code == FOREGROUND:
+                out = (share > 0.5).astype(np.uint8)
+            else:
+                out[(share > 0.5) & (out == BACKDROP)] = UNSURE
+        return out
+
+    maps = LevelMaps(fg)
+    for level in (2, 0, 3, 1, 3):
+        np.testing.assert_array_equal(maps.at(level), made_afresh(level), f"level {level}")
 
 
 def test_a_backdrop_that_moves_is_not_still():
