@@ -11,14 +11,16 @@ those pixels (scaled so that a perfect match reads 1) times the share of the bon
 silhouette. The limb's confidence is its worst seeing view's agreement: every view that
 sees a limb must bear it out, as every view's evidence is needed to move it. A limb no view
 sees has confidence 0 and is flagged ``unseen`` (its pose is the prediction, held); one
-whose confidence is under ``UNSURE`` is flagged ``unsure``: less than half of what it shows
-agrees with the footage. A limb over another body part in every view reads as agreeing
-(its bone is on the silhouette there): the flag misses it.
+whose confidence falls under ``DOUBT`` is flagged ``unsure``, and stays flagged, frame after
+frame, until its confidence is back over ``CLEAR``: a limb lost over another body part reads
+as agreeing there (its bone is on the silhouette, its pixels follow what it covers), so one
+frame's fair agreement does not show that a limb in doubt is found again. A limb over
+another body part in every view from the start reads as agreeing: the flag misses it.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,7 +31,8 @@ from .raycast import BlobStack
 from .skeleton import BALL, HINGE, Skeleton
 
 MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its pixels are visible there
-UNSURE = 0.5  # a limb is flagged below this confidence
+DOUBT = 0.3  # a limb is flagged below this confidence
+CLEAR = 0.8  # a limb flagged on the frame before stays flagged up to this one
 AXIS_POINTS = 9  # points along each blob's long axis whose silhouette is read
 AXIS_REACH = 0.8  # of the blob's long radius, either side of its centre
 UNSEEN, UNSURE_FLAG = "unseen", "unsure"
@@ -37,18 +40,20 @@ UNSEEN, UNSURE_FLAG = "unseen", "unsure"
 
 @dataclass(frozen=True)
 class LimbCheck:
-    """One limb on one frame: its confidence in [0, 1], and per view its agreement in [0, 1]
-    (None where the view does not see it)."""
+    """One limb on one frame: its confidence in [0, 1], per view its agreement in [0, 1]
+    (None where the view does not see it), and whether it was flagged on the frame before
+    (``doubted``)."""
 
     confidence: float
     views: tuple[float | None, ...]
+    doubted: bool = False
 
     @property
     def flag(self) -> str:
         """'' when the limb can be trusted, else ``unseen`` or ``unsure``."""
         if all(v is None for v in self.views):
             return UNSEEN
-        return UNSURE_FLAG if self.confidence < UNSURE else ""
+        return UNSURE_FLAG if self.confidence < (CLEAR if self.doubted else DOUBT) else ""
 
 
 def frame_list(frames) -> str:
@@ -140,12 +145,14 @@ class Limbs:
             out[:, c] = np.where(area > 0, hit / np.maximum(area, 1), np.nan)
         return out
 
-    def checks(self, per_view: Sequence[np.ndarray]) -> dict[str, LimbCheck]:
-        """Each limb's check from its agreement in every view (``view_agreement``'s)."""
+    def checks(self, per_view: Sequence[np.ndarray], doubted: Collection[str] = ()
+               ) -> dict[str, LimbCheck]:
+        """Each limb's check from its agreement in every view (``view_agreement``'s);
+        ``doubted``: the limbs flagged on the frame before."""
         out = {}
         for i, name in enumerate(self.names):
             views = tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
                           for a in per_view)
             seen = [v for v in views if v is not None]
-            out[name] = LimbCheck(min(seen) if seen else 0.0, views)
+            out[name] = LimbCheck(min(seen) if seen else 0.0, views, name in doubted)
         return out

@@ -26,7 +26,7 @@ view where the body is about as large (``auto_scale``, ``core.scales``).
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -563,10 +563,10 @@ class FrameFit:
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
 
     def _limb_checks(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
-                     fgs: list | None) -> dict[str, LimbCheck]:
+                     fgs: list | None, doubted: Collection[str]) -> dict[str, LimbCheck]:
         """Each limb's confidence at the finest level's pose ``kin`` (``core.confidence``):
         per view, its mapped pixels' support (1 for a perfect match) and how much of its
-        bone lies on the silhouette."""
+        bone lies on the silhouette; ``doubted``: the limbs flagged on the frame before."""
         top = 1 + self.settings.outlier_density
         axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
         per_view = []
@@ -586,7 +586,7 @@ class FrameFit:
                 code = crop[px[inside, 1], px[inside, 0]]
                 on[inside] = np.where(code == sil.UNSURE, np.nan, code == sil.FOREGROUND)
             per_view.append(self._limbs.view_agreement(ps.blob, support, on))
-        return self._limbs.checks(per_view)
+        return self._limbs.checks(per_view, doubted)
 
     def _trust(self, delta: np.ndarray) -> np.ndarray:
         """The step shortened so that no joint turns more than ``max_step`` degrees: far from
@@ -637,9 +637,11 @@ class FrameFit:
         return out
 
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
-                    predicted: BodyPose, frame: int) -> FrameResult:
+                    predicted: BodyPose, frame: int, doubted: Collection[str] = ()
+                    ) -> FrameResult:
         """One frame: refine ``predicted`` against the previous frame (``prev`` on
-        ``prev_frame``) and the key frame, coarse to fine. Raises DegenerateSystem."""
+        ``prev_frame``) and the key frame, coarse to fine; ``doubted``: the limbs flagged on
+        the previous frame (``LimbCheck``). Raises DegenerateSystem."""
         s = self.settings
         t0 = time.perf_counter()
         self.scale_to(key)
@@ -716,7 +718,7 @@ class FrameFit:
                         break
         result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
                              iterations=total_iters, converged=converged,
-                             limbs=self._limb_checks(kin, sets, smp, fgs),
+                             limbs=self._limb_checks(kin, sets, smp, fgs, doubted),
                              searched=searched_joints)
         left = self._left_views(smp)
         if left:

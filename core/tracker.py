@@ -224,7 +224,8 @@ class Tracker(FrameFit):
                 else prev.pose.copy(), frame)
             try:
                 with one_blas_thread():
-                    res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame)
+                    res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame,
+                                           {n for n, c in prev.limbs.items() if c.flag})
             except DegenerateSystem as e:
                 res = FrameResult(frame=frame, pose=pred, residual=float("nan"), iterations=0,
                                   converged=False, diverged=True, reason=str(e))

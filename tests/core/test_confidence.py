@@ -7,7 +7,16 @@ import numpy as np
 import pytest
 
 from core import silhouette as sil
-from core.confidence import MIN_LIMB_POINTS, UNSEEN, UNSURE, UNSURE_FLAG, Limbs, frame_list
+from core.confidence import (
+    CLEAR,
+    DOUBT,
+    MIN_LIMB_POINTS,
+    UNSEEN,
+    UNSURE_FLAG,
+    LimbCheck,
+    Limbs,
+    frame_list,
+)
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, BodyPose
 from core.raycast import BlobStack
@@ -114,18 +123,29 @@ def test_a_limb_is_as_sure_as_its_worst_seeing_view_and_unseen_when_no_view_sees
     limbs = _limbs(template)
     a = np.full(len(limbs), 0.9)
     b = np.full(len(limbs), 0.9)
-    a[0], b[0] = 0.8, 0.3  # one view disagrees
+    a[0], b[0] = 0.8, 0.2  # one view disagrees
     a[1], b[1] = np.nan, 0.7  # seen in one view only
     a[2] = b[2] = np.nan  # seen in none
     checks = limbs.checks([a, b])
     first, second, third = (checks[n] for n in limbs.names[:3])
-    assert first.confidence == pytest.approx(0.3) and first.flag == UNSURE_FLAG
-    assert first.views == pytest.approx((0.8, 0.3))
+    assert first.confidence == pytest.approx(0.2) and first.flag == UNSURE_FLAG
+    assert first.views == pytest.approx((0.8, 0.2))
     assert second.confidence == pytest.approx(0.7) and second.flag == ""
     assert second.views[0] is None
     assert third.confidence == 0.0 and third.flag == UNSEEN
     assert all(checks[n].flag == "" for n in limbs.names[3:])
-    assert UNSURE > 0.3
+    assert DOUBT > 0.2 and not any(c.doubted for c in checks.values())
+
+
+@pytest.mark.parametrize("confidence, doubted, flag", [
+    (DOUBT - 0.01, False, UNSURE_FLAG), (DOUBT + 0.01, False, ""),
+    (DOUBT + 0.01, True, UNSURE_FLAG), (CLEAR - 0.01, True, UNSURE_FLAG),
+    (CLEAR + 0.01, True, ""), (CLEAR + 0.01, False, "")])
+def test_a_limb_in_doubt_stays_flagged_until_its_confidence_is_clear(confidence, doubted, flag):
+    """Falling under DOUBT flags a limb; flagged on the frame before, it stays flagged up to
+    CLEAR (a limb lost over the body reads fair there and is not found again by it)."""
+    assert LimbCheck(confidence, (confidence, 0.95), doubted).flag == flag
+    assert LimbCheck(0.0, (None, None), doubted).flag == UNSEEN
 
 
 def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
@@ -143,8 +163,10 @@ def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
     without.blobs = [b for b, i in zip(sk.blobs, limbs.of_blob)
                      if i < 0 or limbs.names[i] != gone]
     frames = [[render(sk, pose, c, noise=0.01, seed=c),
-               render(without, pose, c, noise=0.01, seed=10 + c)] for c in range(3)]
-    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose, [0, 1])
+               render(without, pose, c, noise=0.01, seed=10 + c),
+               render(without, pose, c, noise=0.01, seed=20 + c)] for c in range(3)]
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
+                [0, 1, 2])
     assert res.frames[0].limbs == {}  # the given pose is not judged
     checks = res.frames[1].limbs
     assert set(checks) == set(limbs.names)
@@ -154,6 +176,10 @@ def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
         if name not in chain:
             assert check.flag == "" and check.confidence > checks[gone].confidence + 0.3, (
                 name, check)
+    # the next frame judges each limb knowing which were flagged on this one
+    assert {n for n, c in res.frames[2].limbs.items() if c.doubted} == {
+        n for n, c in checks.items() if c.flag}
+    assert res.frames[2].limbs[gone].flag == UNSURE_FLAG
 
 
 @pytest.mark.parametrize("frames, text", [
