@@ -234,9 +234,12 @@ def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndar
     """How far colours ``seen`` (N, 3) are from their ``backdrop`` colours (N, 3) scaled to
     fit them best (a length in 0-255 units), and that scale: a pixel under a shadow is its
     backdrop scaled, with no colour off it."""
-    f, b = seen.astype(np.float32), backdrop.astype(np.float32)
-    scale = np.sum(f * b, 1) / np.maximum(np.sum(b * b, 1), 1.0)
-    return np.linalg.norm(f - scale[:, None] * b, axis=1), scale
+    f, b = seen.T.astype(np.float32), backdrop.T.astype(np.float32)  # (3, N): per channel
+    scale = (f[0] * b[0] + f[1] * b[1] + f[2] * b[2]) / np.maximum(
+        b[0] * b[0] + b[1] * b[1] + b[2] * b[2], 1.0)
+    off = f - scale * b
+    off *= off
+    return np.sqrt(off[0] + off[1] + off[2]), scale
 
 
 class LevelMaps:

@@ -213,6 +213,20 @@ def test_a_frames_level_maps_asked_in_any_order_are_each_made_from_full_resoluti
         np.testing.assert_array_equal(maps.at(level), made_afresh(level), f"level {level}")
 
 
+def test_a_colours_distance_from_its_backdrop_scaled_is_the_least_squares_residual():
+    """``_chroma``: each pixel's best scale of its backdrop colour and the distance left,
+    against a least-squares fit pixel by pixel (a black backdrop scales by nothing)."""
+    rng = np.random.default_rng(5)
+    seen = rng.integers(0, 256, (40, 3), dtype=np.uint8)
+    backdrop = rng.integers(0, 256, (40, 3), dtype=np.uint8)
+    backdrop[0] = 0
+    off, scale = silhouette._chroma(seen, backdrop)
+    for f, b, o, k in zip(seen.astype(float), backdrop.astype(float), off, scale):
+        fit = np.linalg.lstsq(b[:, None], f, rcond=None)[0][0] if b.any() else 0.0
+        assert k == pytest.approx(fit, rel=1e-5, abs=1e-6)
+        assert o == pytest.approx(np.linalg.norm(f - fit * b), rel=1e-4, abs=1e-3)
+
+
 def test_a_backdrop_that_moves_is_not_still():
     rng = np.random.default_rng(1)
     wall = cv2.GaussianBlur(rng.uniform(0, 1, (120, 220)).astype(np.float32), (0, 0), 1.5)
