@@ -148,10 +148,9 @@ class Backdrop:
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
         if self.chroma_noise is not None and colour is not None and \
                 backdrop_colour is not None and colour.shape == backdrop_colour.shape:
-            ys, xs = np.nonzero(fg)
-            shadow = self.shaded(colour[ys, xs], backdrop_colour[ys, xs])
+            off_backdrop = fg > 0
             unsure = np.zeros(fg.shape, np.uint8)
-            unsure[ys[shadow], xs[shadow]] = 1
+            unsure[off_backdrop] = self.shaded(colour[off_backdrop], backdrop_colour[off_backdrop])
             # specks too: a shadow is a patch, a lone pixel the backdrop's colour is noise
             unsure = cv2.morphologyEx(unsure, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
             fg[unsure > 0] = UNSURE
