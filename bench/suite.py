@@ -2,7 +2,7 @@
 and scored against the capture beside two references on the same frames.
 
     python bench/suite.py [--quick] [--bandai-namco FOLDER] [--settings JSON] [--starts N]
-                          [--clips NAME,...] [--looks NAME,...] [--write PATH]
+                          [--clips NAME,...] [--looks NAME,...] [--workers N] [--write PATH]
 
 Each clip (a capture of ``captures.NAMINGS``) is rendered once per look
 (``suite_footage.LOOKS``) into ``.cache/suite/`` and tracked through ``python -m core
@@ -18,7 +18,9 @@ run is tracked from the clip's first three frames (``--starts``), each posed by 
 and scored by the mean, with the lowest and highest beside it. ``--quick`` (the check for
 every change, a few minutes once the footage is rendered): the CMU clips at 15 fps, from
 the first frame alone. The Bandai Namco clips are non-commercial and never stored in the
-repository: give the folder that holds them (``bn_*.bvh``) to include them.
+repository: give the folder that holds them (``bn_*.bvh``) to include them. Two trackers
+run at once, one per core of a two-core machine; the tracking speed of a run alone, as a
+user's, is ``--workers 1`` (nothing else running).
 """
 
 from __future__ import annotations
@@ -287,6 +289,8 @@ def main(argv=None) -> int:
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     ap.add_argument("--starts", type=int, help="starting frames each clip, look and run is "
                     "tracked from, its scores averaged (default 3, or 1 with --quick)")
+    ap.add_argument("--workers", type=int, default=2,
+                    help="trackers run at once (default 2, one per core; 1 for speed alone)")
     ap.add_argument("--write", type=Path, help="also write the tables to this markdown file")
     a = ap.parse_args(argv)
     clips = list(CLIPS)
@@ -316,7 +320,7 @@ def main(argv=None) -> int:
             jobs += [((clip.name, look, run), k, write_job(clip_dir, look, run, settings, k))
                      for run in runs for k in range(starts)]
     scored: dict[tuple, list[dict]] = {}
-    with ThreadPoolExecutor(2) as pool:  # one tracker per core (each uses one BLAS thread)
+    with ThreadPoolExecutor(a.workers) as pool:  # each tracker uses one BLAS thread
         for (key, k, _), row in zip(jobs, pool.map(
                 lambda j: score_run(j[2], j[0][2], j[1]), jobs)):
             scored.setdefault(key, []).append(row)
