@@ -247,8 +247,7 @@ class FrameFit:
                       ) -> tuple[BodyPose, list[str], tuple]:
         """``est`` with every limb turned to where the silhouette wants it (``LimbSearch``),
         on the level below full resolution, the joints that turned, and the views the search
-        read with each one's ``silhouette.distance_to_body`` map (None for a view it left
-        out)."""
+        read with each one's foreground map (None for a view it left out)."""
         if self.settings.silhouette <= 0:
             return est, [], ()
         self._start_cue(key, key_frame)
@@ -259,15 +258,15 @@ class FrameFit:
             return est, [], ()
         views = [v.at_level(lv) for v, lv in zip(est.views, lvs)]
         fgs = self._search.usable(est, views, fgs)
-        to_body = [None if fg is None else sil.distance_to_body(fg) for fg in fgs]
-        return *self._search.turn(est, views, fgs), (views, to_body)
+        return *self._search.turn(est, views, fgs), (views, fgs)
 
     def _refuted_chain(self, est: BodyPose, searched: BodyPose, limb, backdrops: tuple
                        ) -> tuple[BodyPose, list] | None:
         """``est`` with the search's turns of ``limb`` and of the limbs below it (which the
         search placed for it), and their degrees of freedom, where the backdrops refute
         those limbs at ``est`` and bear them out so turned; else None. Of two or more views
-        with a backdrop (``backdrops``: ``_search_limbs``' views and maps), one must show a
+        with a backdrop (``backdrops``: the search's views and their
+        ``silhouette.distance_to_body`` maps, None for a view it left out), one must show a
         point of their bones where the body cannot be now (``Limbs.bone_off_body``), and
         none one there once turned. A still backdrop's pixel is a plain negative: the body
         is not there. A joint several limbs hang from (the trunk's) is not a limb's."""
@@ -291,9 +290,10 @@ class FrameFit:
         return None
 
     def _pixels_bear_out(self, base: _Samples, cand: BodyPose, limb, sets: list[PointSet],
-                         levels: list, level: int) -> int:
+                         keys: list[np.ndarray], levels: list, level: int) -> int:
         """How many views see ``limb`` where their pixels bear out its turn to ``cand``
-        (from ``base``'s pose), else 0 (``_evidenced``)."""
+        (from ``base``'s pose), else 0 (``_evidenced``); ``keys``: each set's
+        ``PointSet.key_points``."""
         trial = self.sample(cand, Kinematics(self.skeleton, cand), sets, levels, level,
                             base.sigmas)
         moved = self.skeleton.moved_by()
@@ -310,16 +310,18 @@ class FrameFit:
                 clear += 1
                 vouched += 1
                 continue
-            key = both & ps.key_points()[on]
+            key = both & keys[c][on]
             vouched += bool(key.sum() >= MIN_LIMB_POINTS
                             and _clearly_lower(new[key], old[key]))
         return seen if seen and (clear == seen or (seen > 1 and vouched == seen)) else 0
 
     def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
-                   sets: list[PointSet], levels: list, level: int, backdrops: tuple = ()
+                   sets: list[PointSet], levels: list, level: int, searched_on: tuple = ()
                    ) -> tuple[BodyPose, list[str]]:
         """``est`` with the turns of ``searched`` that the footage bears out, and the joints
-        so turned where two or more views bore the turn out (``FrameResult.searched``).
+        so turned where two or more views bore the turn out (``FrameResult.searched``);
+        ``searched_on``: the views the search read and their foreground maps
+        (``_search_limbs``').
         Parents first, a limb's turn is kept when the backdrops refute the limb where it is
         and bear it out turned, with the limbs below it (``_refuted_chain``), or when, in
         every view that sees the limb, its pixels of the earlier frames match the new image
@@ -335,6 +337,12 @@ class FrameFit:
         shadow, or foreground another limb left uncovered, as well as the limb, and what
         the footage does not show is held."""
         base = self.sample(est, Kinematics(self.skeleton, est), sets, levels, level)
+        keys = [ps.key_points() for ps in sets]
+        backdrops = ()  # the search's views (``searched_on``) with their distance maps
+        if searched_on:
+            views, fgs = searched_on
+            backdrops = (views, [None if fg is None else sil.distance_to_body(fg)
+                                 for fg in fgs])
         out, kept = est, []
         for limb in self._search.limbs:
             if self.skeleton.names[limb.joint] not in turned:
@@ -346,7 +354,7 @@ class FrameFit:
                 cand = out.copy()
                 for j, _, _ in limb.dofs:
                     cand.rotations[j] = searched.rotations[j]
-                seen = self._pixels_bear_out(base, cand, limb, sets, levels, level)
+                seen = self._pixels_bear_out(base, cand, limb, sets, keys, levels, level)
                 if not seen:
                     continue
                 out, dofs = cand, limb.dofs if seen > 1 else []
@@ -666,10 +674,10 @@ class FrameFit:
                 sets.append(PointSet.joined(view_sets))
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and level == self.scales.search_level():
-                searched, turned, backdrops = self._search_limbs(est, frame, key, key_frame)
+                searched, turned, searched_on = self._search_limbs(est, frame, key, key_frame)
                 if turned:
                     searched, searched_joints = self._evidenced(est, searched, turned, sets,
-                                                                levels, level, backdrops)
+                                                                levels, level, searched_on)
                 if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)

@@ -249,7 +249,6 @@ class LevelMaps:
     from one level to the next, so every level of a frame costs one pyramid."""
 
     def __init__(self, fg: np.ndarray):
-        self.fg = fg
         # per code, its share of each level's pixels (finest first); unsure only if any is
         self._shares = {code: [(fg == code).astype(np.float32)] for code in (FOREGROUND, UNSURE)
                         if code == FOREGROUND or np.any(fg == UNSURE)}
@@ -266,11 +265,6 @@ class LevelMaps:
                 out[(self._shares[UNSURE][level] > 0.5) & (out == BACKDROP)] = UNSURE
             self._maps[level] = out
         return self._maps[level]
-
-
-def at_level(fg: np.ndarray, level: int) -> np.ndarray:
-    """A full-resolution foreground map as one on pyramid level ``level`` (``LevelMaps``)."""
-    return LevelMaps(fg).at(level)
 
 
 @dataclass

@@ -20,7 +20,6 @@ from core.silhouette import (
     LevelMaps,
     NearestPixel,
     SilhouetteCue,
-    at_level,
     mismatch,
 )
 from core.skeleton import planar_chain_template
@@ -100,7 +99,7 @@ def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
     fg = bd.foreground(frame((100, 50))) > 0
     truth = _disc(shape, (100, 50), 18)
     assert (fg & truth).sum() / (fg | truth).sum() > 0.97
-    np.testing.assert_array_equal(at_level(fg.astype(np.float32), 1).shape,
+    np.testing.assert_array_equal(LevelMaps(fg.astype(np.float32)).at(1).shape,
                                   cv2.pyrDown(fg.astype(np.float32)).shape)
 
 
@@ -181,10 +180,10 @@ def test_a_foreground_map_on_a_coarser_level_keeps_its_codes():
     fg = np.full(shape, BACKDROP, np.uint8)
     fg[_disc(shape, (30, 30), 12)] = FOREGROUND
     fg[_disc(shape, (70, 30), 12)] = UNSURE
-    lv = at_level(fg, 2)
+    lv = LevelMaps(fg).at(2)
     assert lv.shape == (16, 24)
     assert lv[7, 7] == FOREGROUND and lv[7, 17] == UNSURE and lv[1, 12] == BACKDROP
-    np.testing.assert_array_equal(at_level(fg == FOREGROUND, 2) == FOREGROUND,
+    np.testing.assert_array_equal(LevelMaps(fg == FOREGROUND).at(2) == FOREGROUND,
                                   lv == FOREGROUND)
 
 
