@@ -439,20 +439,12 @@ class FrameFit:
         return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
 
     def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int,
-                   grid: int):
+                   grid: int) -> tuple[np.ndarray, raycast.LabelGrid]:
         """Front-most blob (-1: none) at every ``grid``-th level pixel, as a map whose pixel
-        (i, j) is level pixel (grid i, grid j), and per map pixel the index of its hit."""
+        (i, j) is level pixel (grid i, grid j), and the z-buffer it came from."""
         v_l = pose.views[view].at_level(lv)
-        pix, hits, box = raycast.render_labels(v_l, self._blobs, kin.segments, shape,
-                                               grid)
-        size = (-(-shape[0] // grid), -(-shape[1] // grid))
-        lab = np.full(size, -1, dtype=np.int32)
-        idx = np.full(size, -1, dtype=np.int32)
-        if box is not None:
-            at = (pix[:, 1].astype(int) // grid, pix[:, 0].astype(int) // grid)
-            lab[at] = hits.label
-            idx[at] = np.arange(len(pix))
-        return lab, idx, hits
+        labels = raycast.label_grid(v_l, self._blobs, kin.segments, shape, grid)
+        return labels.full(shape), labels
 
     # --- one level -----------------------------------------------------------------------
     def sample(self, est: BodyPose, kin: Kinematics, sets: list[PointSet], levels: list,
@@ -473,7 +465,7 @@ class FrameFit:
         labels = [m[0] for m in maps]
         shape_cost, shape_parts = 0.0, []
         if fgs is not None:
-            for c, ((lab, idx, hits), view_fg) in enumerate(zip(maps, fgs)):
+            for c, ((lab, grid), view_fg) in enumerate(zip(maps, fgs)):
                 if view_fg is None:
                     shape_parts.append(((), (), (), ()))
                     continue
@@ -485,8 +477,9 @@ class FrameFit:
                 shape_cost += s.silhouette * mm.cost
                 mm.model += (x0, y0)
                 mm.target += (x0, y0)
-                h = idx[mm.model[:, 1].astype(int), mm.model[:, 0].astype(int)]
-                shape_parts.append((self._blobs.joint[hits.label[h]], hits.world[h],
+                hits = grid.hits_on_full(mm.model[:, 1].astype(int),
+                                         mm.model[:, 0].astype(int))
+                shape_parts.append((self._blobs.joint[hits.label], hits.world,
                                     mm.target * full, mm.weight))
         measured = []
         for k, ps in enumerate(sets):

@@ -131,13 +131,83 @@ def _clip_box(lo, hi, shape, margin: int):
     return None if x0 >= x1 or y0 >= y1 else (x0, y0, x1, y1)
 
 
+@dataclass
+class LabelGrid:
+    """The front-most blob at every ``step``-th pixel of a view's silhouette box: ``label``
+    (rows, cols), -1 where no blob shows, its cell (i, j) at pixel (x0 + step j, y0 + step i)
+    of ``box`` = (x0, y0, x1, y1), x0 and y0 multiples of ``step`` (None, and an empty grid,
+    when nothing shows). The hits at its cells are worked out when asked (``hits``): most
+    label maps are read for their labels alone."""
+
+    label: np.ndarray
+    box: tuple | None
+    step: int
+    _key: np.ndarray  # per cell the z-buffer's depth key (``label_grid``)
+    _disc: np.ndarray  # per cell the front blob's discriminant over a^2
+    _view: Camera
+    _coefs: tuple  # per blob a, e0, ex, ey (``label_grid``)
+
+    def covered(self) -> tuple[np.ndarray, np.ndarray]:
+        """Grid rows and columns of the cells a blob covers, in row-major order."""
+        return np.nonzero(self.label >= 0)
+
+    def pixels(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Pixel coordinates (N, 2) of grid cells, as floats."""
+        x0, y0 = (0, 0) if self.box is None else self.box[:2]
+        return np.stack([x0 + self.step * cols, y0 + self.step * rows], 1).astype(float)
+
+    def full(self, shape) -> np.ndarray:
+        """The labels on the map of every ``step``-th pixel of an image of ``shape``
+        (ceil(H / step), ceil(W / step)), whose pixel (i, j) is pixel (step j, step i)."""
+        out = np.full((-(-shape[0] // self.step), -(-shape[1] // self.step)), -1, np.int32)
+        i, j = self._at
+        out[i:i + self.label.shape[0], j:j + self.label.shape[1]] = self.label
+        return out
+
+    def hits_on_full(self, rows: np.ndarray, cols: np.ndarray) -> Hits:
+        """``hits`` at covered pixels (rows, cols) of ``full``'s map."""
+        i, j = self._at
+        return self.hits(rows - i, cols - j)
+
+    @property
+    def _at(self) -> tuple[int, int]:
+        """The grid's first cell on ``full``'s map."""
+        return (0, 0) if self.box is None else (self.box[1] // self.step,
+                                                self.box[0] // self.step)
+
+    def hits(self, rows: np.ndarray, cols: np.ndarray) -> Hits:
+        """The hits at covered grid cells (``covered``'s, or any of them)."""
+        view, (a, e0, ex, ey) = self._view, self._coefs
+        pixels = self.pixels(rows, cols)
+        key, lab = self._key[rows, cols], self.label[rows, cols]
+        o0, ox, oy, r0, rx, ry = view.ray_lines()
+        u, v = pixels[:, :1], pixels[:, 1:]
+        ray = r0 + u * rx + v * ry
+        lam = -1.0 / key if view.central else key  # along ``ray``
+        norm = np.linalg.norm(ray, axis=1)
+        e = e0[lab] + u * ex[lab] + v * ey[lab]
+        rim = self._disc[rows, cols] * a[lab] ** 2 / np.sum(e * e, 1)  # (b^2 - a c) / |e|^2
+        return Hits(lab, lam * norm, o0 + u * ox + v * oy + lam[:, None] * ray,
+                    np.minimum(rim, 1.0))
+
+
 def render_labels(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, step: int = 1
                   ) -> tuple[np.ndarray, Hits, tuple]:
-    """Z-buffer the pixels of the silhouette box whose coordinates are multiples of ``step``,
-    over every blob's own box at once; returns the covered pixels (N, 2), their hits and
-    the box (None if nothing shows).
+    """Z-buffer the pixels of the silhouette box whose coordinates are multiples of ``step``:
+    the covered pixels (N, 2), their hits and the box (None if nothing shows); the same as
+    :func:`cast` on those pixels (``label_grid``)."""
+    grid = label_grid(view, blobs, g, shape, step)
+    rows, cols = grid.covered()
+    return grid.pixels(rows, cols), grid.hits(rows, cols), grid.box
 
-    Same result as :func:`cast` on those pixels, at a fraction of the work: each blob's
+
+def label_grid(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, step: int = 1
+               ) -> LabelGrid:
+    """Z-buffer the pixels of the silhouette box (of an image of ``shape``) whose coordinates
+    are multiples of ``step``, over every blob's own box at once, blobs posed by segment
+    motions g (J, 4, 4).
+
+    Same labels as :func:`cast` on those pixels, at a fraction of the work: each blob's
     quadratic's coefficients are polynomials in the pixel, evaluated on its box."""
     blobs = BlobStack.of(blobs)
     Rs, C = _posed(blobs, g)  # once, for the boxes and the blobs' normalised frames
@@ -145,10 +215,12 @@ def render_labels(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, st
     boxes = _boxes(view, A, C) if len(blobs) else np.zeros((0, 4))
     box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if len(blobs) else None
     if box is None:
-        empty = np.zeros((0, 2))
-        return empty, cast(view, empty, blobs, g), None
+        empty = np.zeros((0, 0))
+        return LabelGrid(np.zeros((0, 0), np.int64), None, step, empty, empty, view,
+                         (np.zeros(0),) + (np.zeros((0, 3)),) * 3)
     x0, y0, x1, y1 = box
     x0, y0 = x0 - x0 % step, y0 - y0 % step  # the grid: multiples of step
+    box = x0, y0, x1, y1
     xs = np.arange(x0, x1, step, dtype=float)
     ys = np.arange(y0, y1, step, dtype=float)
     depth = np.full((len(ys), len(xs)), np.inf)
@@ -163,18 +235,13 @@ def render_labels(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, st
     # c = |e|^2, and the nearer root is -m. Either way the root (-b - sqrt(b^2 - a c)) / a
     # is a depth key, smaller nearer: in terms of the fixed vector f and the affine one
     # p = p0 + u px + v py, a = |f|^2 - [pinhole], b = +-p.f, c = |p|^2 - [orthography]
-    if view.central:
-        f, (p0, px, py), sign = w0, (e0, ex, ey), -1.0
-    else:
-        f, (p0, px, py), sign = e0, (w0, wx, wy), 1.0
-
-    def dot(p, q):
-        return np.sum(p * q, 1)
-
-    a = dot(f, f) - view.central
-    b0, bx, by = (sign * dot(p, f) for p in (p0, px, py))
-    c00, c0x, c0y = dot(p0, p0) - (not view.central), dot(p0, px), dot(p0, py)
-    cxx, cxy, cyy = dot(px, px), dot(px, py), dot(py, py)
+    fp = np.stack([w0, e0, ex, ey] if view.central else [e0, w0, wx, wy], 1)  # f, p0, px, py
+    dots = np.sum(fp[:, :, None] * fp[:, None], -1)  # (E, 4, 4): every pair's dot product
+    sign = -1.0 if view.central else 1.0
+    a = dots[:, 0, 0] - view.central
+    b0, bx, by = sign * dots[:, 0, 1:].T
+    c00, c0x, c0y = dots[:, 1, 1] - (not view.central), dots[:, 1, 2], dots[:, 1, 3]
+    cxx, cxy, cyy = dots[:, 2, 2], dots[:, 2, 3], dots[:, 3, 3]
     d00, dx, dy = b0 * b0 - a * c00, 2 * (b0 * bx - a * c0x), 2 * (b0 * by - a * c0y)
     dxx, dxy, dyy = bx * bx - a * cxx, 2 * (bx * by - a * cxy), by * by - a * cyy
     # each blob's grid columns and rows: its box widened by a pixel, clipped to the image
@@ -196,8 +263,9 @@ def render_labels(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, st
     blob = np.repeat(np.arange(len(size)), size)
     k = np.arange(len(blob)) - np.repeat(np.cumsum(size) - size, size)  # index in its box
     width = cols_n[blob]
-    r = first[blob, 1] + k // width
-    c = first[blob, 0] + k % width
+    r, c = np.divmod(k, width)
+    r += first[blob, 1]
+    c += first[blob, 0]
     at_r, at_c = blob * len(ys) + r, blob * len(xs) + c  # into the (E, rows), (E, cols) tables
     disc = DV.take(at_r) + DU.take(at_c) + ys.take(r) * KUV.take(at_c)
     hit = disc > 0
@@ -218,15 +286,4 @@ def render_labels(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, st
     won = front & (flat_label[cell] == blob)
     disc_front[cell[won]] = disc[won]
     disc_front = disc_front.reshape(depth.shape)
-    vv, uu = np.nonzero(label >= 0)
-    pixels = np.stack([xs[uu], ys[vv]], 1)
-    key = depth[vv, uu]
-    lab = label[vv, uu]
-    u, v = pixels[:, :1], pixels[:, 1:]
-    ray = r0 + u * rx + v * ry
-    lam = -1.0 / key if view.central else key  # along ``ray``
-    norm = np.linalg.norm(ray, axis=1)
-    e = e0[lab] + u * ex[lab] + v * ey[lab]
-    rim = disc_front[vv, uu] * a[lab] ** 2 / np.sum(e * e, 1)  # (b^2 - a c) / |e|^2
-    hits = Hits(lab, lam * norm, o0 + u * ox + v * oy + lam[:, None] * ray, np.minimum(rim, 1.0))
-    return pixels, hits, box
+    return LabelGrid(label, box, step, depth, disc_front, view, (a, e0, ex, ey))

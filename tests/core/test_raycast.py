@@ -68,6 +68,30 @@ def test_rasterised_labels_equal_per_pixel_casting(camera):
 
 
 @CAMERAS
+def test_a_label_grids_image_map_and_its_hits_there_match_casting_every_pixel(camera):
+    """``LabelGrid.full`` labels every step-th pixel of the image as casting that pixel does,
+    and ``hits_on_full`` at a map pixel is that pixel's cast hit."""
+    sk, g = _posed(4)
+    view = camera(yaw_deg=30)
+    shape = (350, 310)
+    for step in (1, 2, 3):
+        grid = raycast.label_grid(view, sk.blobs, g, shape, step)
+        full = grid.full(shape)
+        assert full.shape == (-(-350 // step), -(-310 // step))
+        ys, xs = np.mgrid[0:full.shape[0], 0:full.shape[1]]
+        pix = np.stack([xs.ravel(), ys.ravel()], 1) * step
+        ref = raycast.cast(view, pix.astype(float), sk.blobs, g)
+        np.testing.assert_array_equal(full.ravel(), ref.label)
+        rows, cols = np.nonzero(full >= 0)
+        pick = np.random.default_rng(step).choice(len(rows), 50, replace=False)
+        hits = grid.hits_on_full(rows[pick], cols[pick])
+        at = rows[pick] * full.shape[1] + cols[pick]
+        np.testing.assert_array_equal(hits.label, ref.label[at])
+        np.testing.assert_allclose(hits.world, ref.world[at], atol=1e-9)
+        np.testing.assert_allclose(hits.rim, ref.rim[at], atol=1e-9)
+
+
+@CAMERAS
 def test_hit_points_lie_on_their_blob_surface(camera):
     sk, g = _posed(7)
     view = camera(yaw_deg=10)
