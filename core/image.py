@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -60,22 +61,37 @@ def check_footage(paths, where: str) -> None:
     a movie's frames or arrays, are not checked) that cannot be decoded, or that differs in
     size from the first, before any is tracked: a file cut short in the middle of a sequence
     must not stop a run half way, and frames of one view are one camera's (cells cropped
-    each its own way are not). The decoder's own complaints are kept off the terminal."""
-    size = first = None
+    each its own way are not). The files are decoded on every core (the decoder releases
+    the interpreter's lock); its own complaints are kept off the terminal."""
     paths = getattr(paths, "source", paths)  # footage read undistorted: its files
+    files = [p for p in paths if isinstance(p, (str, Path))]
+    if not files:
+        return
+    size = first = None
+    pool = ThreadPoolExecutor(os.cpu_count() or 1, thread_name_prefix="twist-check")
     with quiet_stderr():
-        for p in (p for p in paths if isinstance(p, (str, Path))):
-            img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
-            if img is None:
-                raise ImageError(f"{p}: cannot read this image ({where}; cut short, or not an "
-                                 "image format): replace it, or leave it out of the footage")
-            if size is None:
-                size, first = img.shape, p
-            elif img.shape != size:
-                raise ImageError(
-                    f"{where}: its images differ in size ({Path(first).name} is "
-                    f"{size[1]}x{size[0]}, {Path(p).name} {img.shape[1]}x{img.shape[0]}): "
-                    "crop or pad them to one size, lined up as the camera saw them")
+        try:
+            shapes = pool.map(_decoded_shape, files)
+            for p, shape in zip(files, shapes):
+                if shape is None:
+                    raise ImageError(f"{p}: cannot read this image ({where}; cut short, or not "
+                                     "an image format): replace it, or leave it out of the "
+                                     "footage")
+                if size is None:
+                    size, first = shape, p
+                elif shape != size:
+                    raise ImageError(
+                        f"{where}: its images differ in size ({Path(first).name} is "
+                        f"{size[1]}x{size[0]}, {Path(p).name} {shape[1]}x{shape[0]}): "
+                        "crop or pad them to one size, lined up as the camera saw them")
+        finally:  # the decodes still running finish while the decoder is quiet
+            pool.shutdown(cancel_futures=True)
+
+
+def _decoded_shape(path) -> tuple[int, int] | None:
+    """(height, width) of an image file, decoded whole; None if it cannot be."""
+    img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    return None if img is None else img.shape
 
 
 class quiet_stderr:
