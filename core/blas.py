@@ -2,8 +2,10 @@
 
 The tracker's matrix products are small (a few thousand rows by a few dozen columns): BLAS
 workers on other cores save little on them and, on a two-core machine, stall the tracker while
-they wait for the core that reads the next frame (``core.sequence``). The thread count is put
-back after each frame, so the rest of the process (Blender, other add-ons) keeps its own.
+they wait for the core that reads the next frame (``core.sequence``), and once woken they spin
+there (``sched_yield``) for a while after the product is done: a frame's every product, the
+backdrops' learning from it included, runs on one thread. The thread count is put back after
+each frame, so the rest of the process (Blender, other add-ons) keeps its own.
 
 This talks to the OpenBLAS that numpy's wheels bundle, found beside numpy; with any other BLAS
 it does nothing.

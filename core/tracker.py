@@ -218,33 +218,9 @@ class Tracker(FrameFit):
                 # the error the correction takes out, which carried on flung the next frames
                 history = history[-1:] + [res] if prev.given else [res]
                 continue
-            held = [n for n, why in prev.flagged.items() if why == UNSEEN] + prev.searched
-            pred = self._filmed_from(
-                self.predict(history[-2].pose, prev.pose, held) if len(history) >= 2
-                else prev.pose.copy(), frame)
-            try:
-                with one_blas_thread():
-                    res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame,
-                                           {n for n, c in prev.limbs.items() if c.flag})
-            except DegenerateSystem as e:
-                res = FrameResult(frame=frame, pose=pred, residual=float("nan"), iterations=0,
-                                  converged=False, diverged=True, reason=str(e))
-            if not res.diverged:
-                if not all(np.isfinite(res.pose.rotations).flat):
-                    res.diverged, res.reason = True, "the solution is not finite"
-                elif residuals and res.residual > self.settings.divergence_ratio * max(
-                    float(np.median(residuals)), self.settings.noise_floor
-                ):
-                    res.diverged = True
-                    res.reason = (
-                        f"residual {res.residual:.4f} is over {self.settings.divergence_ratio}x"
-                        f" the median so far ({np.median(residuals):.4f})"
-                    )
+            with one_blas_thread():
+                res = self._next_frame(history, key, key_frame, frame, residuals)
             residuals.append(res.residual)
-            if not res.diverged:
-                if self.hold_turn_in_depth:
-                    res.turned = turned_from(key, res.pose)
-                self._learn_backdrops(res)
             self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
                                 for f in (key_frame, prev.frame, frame)})
             yield res
@@ -252,6 +228,37 @@ class Tracker(FrameFit):
                 return
             history = history[-1:] + [res]
 
+    def _next_frame(self, history: list[FrameResult], key: BodyPose, key_frame: int,
+                    frame: int, residuals: list[float]) -> FrameResult:
+        """Track ``frame`` from the results before it (``history``, the last one or two),
+        judge it diverged against the residuals so far, and let the backdrops learn from
+        it."""
+        prev = history[-1]
+        held = [n for n, why in prev.flagged.items() if why == UNSEEN] + prev.searched
+        pred = self._filmed_from(
+            self.predict(history[-2].pose, prev.pose, held) if len(history) >= 2
+            else prev.pose.copy(), frame)
+        try:
+            res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame,
+                                   {n for n, c in prev.limbs.items() if c.flag})
+        except DegenerateSystem as e:
+            return FrameResult(frame=frame, pose=pred, residual=float("nan"), iterations=0,
+                               converged=False, diverged=True, reason=str(e))
+        if res.diverged:
+            return res
+        if not all(np.isfinite(res.pose.rotations).flat):
+            res.diverged, res.reason = True, "the solution is not finite"
+        elif residuals and res.residual > self.settings.divergence_ratio * max(
+                float(np.median(residuals)), self.settings.noise_floor):
+            res.diverged = True
+            res.reason = (f"residual {res.residual:.4f} is over "
+                          f"{self.settings.divergence_ratio}x the median so far "
+                          f"({np.median(residuals):.4f})")
+        else:
+            if self.hold_turn_in_depth:
+                res.turned = turned_from(key, res.pose)
+            self._learn_backdrops(res)
+        return res
 
 
 def track(

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from core import se3
+from core import blas, se3
 from core.camera import View
 from core.errors import InputError
 from core.frame_fit import PointSet
@@ -680,3 +680,34 @@ def test_a_limb_no_view_showed_is_not_turned_onto_an_outline_alone(body):
     assert res.frames[1].flagged["LeftShoulder"] == "unseen"
 
     assert np.abs(_joint_pixels(sk, res.frames[1].pose) - _joint_pixels(sk, side)).max() < 3.0
+
+
+def test_a_frame_is_tracked_and_learned_from_on_one_blas_thread(body, monkeypatch):
+    """Every frame's work, the backdrops learning from it included, runs with one BLAS thread
+    (threads woken outside spun on the other core, taking it from the frame reader), and the
+    caller has its own count back between frames."""
+    calls = blas._thread_calls()
+    if calls is None:
+        pytest.skip("numpy brings no OpenBLAS here")
+    sk, pose = body
+    tracker = Tracker(sk, [[render(sk, pose, c)] * 3 for c in range(3)], CALIBRATED)
+    inside = []
+
+    def recorded(name):
+        method = getattr(tracker, name)
+
+        def call(*args):
+            inside.append((name, blas.blas_threads()))
+            return method(*args)
+        return call
+
+    for name in ("track_frame", "_learn_backdrops"):
+        monkeypatch.setattr(tracker, name, recorded(name))
+    before = calls[0]()
+    calls[1](2)
+    try:
+        between = [blas.blas_threads() for _ in tracker.iter_track(pose, [0, 1, 2])]
+    finally:
+        calls[1](before)
+    assert between == [2, 2, 2]
+    assert inside == [("track_frame", 1), ("_learn_backdrops", 1)] * 2
