@@ -78,6 +78,12 @@ class Skeleton:
         for m in range(J):
             self._moved_by[m, self.ancestors(m)] = True
         self._moved_by.setflags(write=False)
+        depth = np.zeros(J, dtype=int)
+        for j in range(1, J):
+            depth[j] = depth[self.parents[j]] + 1
+        # the joints below the root by their number of ancestors: each generation's frames
+        # follow from the one before's at once
+        self._generations = [np.flatnonzero(depth == d) for d in range(1, depth.max() + 1)]
         self._dofs = None
 
     @property
@@ -184,14 +190,14 @@ class Skeleton:
         """World frames M_j (J, 4, 4) of every joint for local rotations (J, 3, 3); with
         ``offsets`` (J, 3), of the same hierarchy with those bone offsets instead."""
         offsets = self.offsets if offsets is None else offsets
-        J = self.n_joints
-        M = np.empty((J, 4, 4))
+        M = np.empty((self.n_joints, 4, 4))
         M[0] = se3.rigid(rotations[0], root_position)
-        for j in range(1, J):
-            p = self.parents[j]
-            M[j, :3, :3] = M[p, :3, :3] @ rotations[j]
-            M[j, :3, 3] = M[p, :3, :3] @ offsets[j] + M[p, :3, 3]
-            M[j, 3] = (0, 0, 0, 1)
+        M[1:, 3] = (0, 0, 0, 1)
+        for js in self._generations:
+            ps = self.parents[js]
+            turn = M[ps, :3, :3]
+            M[js, :3, :3] = turn @ rotations[js]
+            M[js, :3, 3] = (turn @ offsets[js, :, None])[..., 0] + M[ps, :3, 3]
         return M
 
     def segment_motions(self, frames: np.ndarray) -> np.ndarray:

@@ -23,7 +23,7 @@ def test_segment_motions_are_the_product_of_exponentials(cmu_walk):
     g = sk.segment_motions(sk.joint_frames(R, root))
     p = sk.rest_positions
     G0 = se3.rigid(R[0], root) @ se3.rigid(np.eye(3), -p[0])
-    for k in [sk.index("LeftToe"), sk.index("RThumb"), sk.index("Head")]:
+    for k in range(1, sk.n_joints):  # every joint, each generation of the tree
         chain = sk.ancestors(k)[::-1][1:]  # root excluded, root first
         expect = G0.copy()
         for j in chain:
