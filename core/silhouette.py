@@ -19,8 +19,10 @@ pull. A foreground map holds one code per pixel: ``BACKDROP``, ``FOREGROUND`` or
 
 from __future__ import annotations
 
+import os
 from collections import deque
 from collections.abc import Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import cv2
@@ -381,40 +383,50 @@ class SilhouetteCue:
         (``bodies``: per view, its pixels on the key frame) painted out ``margins`` pixels
         wide; checked against frames spread over the footage. ``body_at``: a world point
         of the body on the key frame (how far a moving camera's backdrop is, at least).
-        Returns the notes on views whose backdrop does not hold."""
+        Returns the notes on views whose backdrop does not hold. The views' backdrops are
+        made on every core (reading frames and painting in are OpenCV's work, which lets
+        go of the interpreter's lock)."""
         others = np.linspace(0, self.seq.n_frames() - 1, BACKDROP_FRAMES).astype(int)
         others = sorted(set(others) - {key_frame})
-        self.backdrops, notes = [], []
-        for c, (body, margin, path) in enumerate(zip(bodies, margins, self.moving)):
-            if path is not None and not turns_in_place(path, body_at):
-                notes.append(f"view {c + 1}: its camera moves, and not only turns about its "
-                             "centre, so its backdrop moves with it and its silhouette is "
-                             "not used")
-                self.backdrops.append(None)
-                continue
-            if path is not None:
-                grey, colour = self.seq.grey(c, key_frame), self.seq.colour(c, key_frame)
-                frames = (self._turned(path, f, key_frame, *self.seq.peek(c, f))
-                          for f in others)
-                backdrop = Backdrop(grey, body, frames, margin, colour, reach=TURNING_REACH)
-            else:
-                grey, colour = self.plates[c] or (self.seq.grey(c, key_frame),
-                                                  self.seq.colour(c, key_frame))
-                backdrop = Backdrop(grey, body, (self.seq.peek(c, f) for f in others),
-                                    margin, colour, clean=self.plates[c] is not None)
-            if not backdrop.still:
-                notes.append(f"view {c + 1}: " + (
-                    "the footage around the body changes from frame to frame far more than "
-                    "a body's outline (a moving camera or light, or a first pose that does "
-                    "not cover the body)" if path is None else
-                    "its camera's turn, as given, does not line up the scene from frame to "
-                    "frame (check the camera's keys or solve, and its lens)") +
-                    ", so its silhouette is not used")
-                self.backdrops.append(None)
-                continue
-            self.backdrops.append(backdrop if path is None else
-                                  TurningBackdrop(backdrop, key_frame, path))
-        return notes
+        keyed = [self.plates[c] if path is None and self.plates[c] is not None else
+                 (self.seq.grey(c, key_frame), self.seq.colour(c, key_frame))
+                 for c, path in enumerate(self.moving)]  # read here: the cache is not shared
+
+        def made(c: int) -> tuple[Backdrop | TurningBackdrop | None, str | None]:
+            return self._backdrop(c, keyed[c], bodies[c], margins[c], others, key_frame,
+                                  body_at)
+
+        with ThreadPoolExecutor(os.cpu_count() or 1, thread_name_prefix="twist-backdrop") \
+                as pool:
+            views = list(pool.map(made, range(self.seq.n_views)))
+        self.backdrops = [backdrop for backdrop, _ in views]
+        return [note for _, note in views if note is not None]
+
+    def _backdrop(self, c: int, keyed: tuple, body: np.ndarray, margin: int, others: list[int],
+                  key_frame: int, body_at: np.ndarray
+                  ) -> tuple[Backdrop | TurningBackdrop | None, str | None]:
+        """View ``c``'s backdrop (``start``), or None and the note saying why it has none;
+        ``keyed``: its clean plate or key frame (grey, colour)."""
+        path = self.moving[c]
+        if path is not None and not turns_in_place(path, body_at):
+            return None, (f"view {c + 1}: its camera moves, and not only turns about its "
+                          "centre, so its backdrop moves with it and its silhouette is not "
+                          "used")
+        if path is not None:
+            frames = (self._turned(path, f, key_frame, *self.seq.peek(c, f)) for f in others)
+            backdrop = Backdrop(keyed[0], body, frames, margin, keyed[1], reach=TURNING_REACH)
+        else:
+            backdrop = Backdrop(keyed[0], body, (self.seq.peek(c, f) for f in others),
+                                margin, keyed[1], clean=self.plates[c] is not None)
+        if not backdrop.still:
+            return None, f"view {c + 1}: " + (
+                "the footage around the body changes from frame to frame far more than a "
+                "body's outline (a moving camera or light, or a first pose that does not "
+                "cover the body)" if path is None else
+                "its camera's turn, as given, does not line up the scene from frame to frame "
+                "(check the camera's keys or solve, and its lens)") + \
+                ", so its silhouette is not used"
+        return (backdrop if path is None else TurningBackdrop(backdrop, key_frame, path)), None
 
     @staticmethod
     def _turned(path: Sequence[Pinhole], frame: int, to: int, grey: np.ndarray,
