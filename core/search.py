@@ -45,6 +45,9 @@ UNCOVERED_GAIN = 0.6
 SIDE_ON = np.cos(np.radians(25))  # a hinge axis this close to one view's direction turns
 MIN_FOREGROUND = 0.7  # share of the body's outline that must be foreground to search a view
 TURN_SCALE = 45.0  # degrees: a turn this far on one dof must beat the prediction by 2 margins
+# what covering a pixel costs, by its foreground map's code (``LimbSearch._gain_sums``)
+_COVER_COST = np.zeros(3)
+_COVER_COST[[FOREGROUND, BACKDROP]] = -UNCOVERED_GAIN, 1.0
 
 
 @dataclass
@@ -100,9 +103,10 @@ def paint(mask: np.ndarray, view: Camera, A: np.ndarray, C: np.ndarray, box: tup
     e, rows = np.nonzero(hi > lo)
     # +1 where a span starts, -1 one past its end: a pixel is covered where the running sum
     # along its row is positive
-    edges = np.zeros((mask.shape[0], mask.shape[1] + 1), np.int32)
-    np.add.at(edges, (rows, lo[e, rows]), 1)
-    np.add.at(edges, (rows, hi[e, rows]), -1)
+    width = mask.shape[1] + 1
+    at, size = rows * width, mask.shape[0] * width
+    edges = (np.bincount(at + lo[e, rows], minlength=size)
+             - np.bincount(at + hi[e, rows], minlength=size)).reshape(-1, width)
     mask |= np.cumsum(edges[:, :-1], axis=1) > 0
 
 
@@ -211,9 +215,8 @@ class LimbSearch:
         x0, y0, x1, y1 = box
         others = np.zeros((y1 - y0, x1 - x0), bool)
         paint(others, view, A, C, box)
-        code = fg[y0:y1, x0:x1]
-        gain = np.where(others, 0.0, np.select([code == FOREGROUND, code == BACKDROP],
-                                               [-UNCOVERED_GAIN, 1.0], 0.0))
+        gain = _COVER_COST.take(fg[y0:y1, x0:x1])
+        gain[others] = 0.0
         S = np.zeros((gain.shape[0], gain.shape[1] + 1))
         np.cumsum(gain, axis=1, out=S[:, 1:])
         return S

@@ -41,6 +41,30 @@ def test_outlines_cover_exactly_the_pixels_whose_rays_hit_a_blob():
         assert np.sum(painted != cast) <= 2, np.sum(painted != cast)  # round-off on the rim
 
 
+def test_covering_a_pixel_costs_by_its_code_and_nothing_under_the_rest_of_the_body():
+    """``_gain_sums``' row prefix sums against each pixel's cost worked out alone: 1 on the
+    backdrop, -UNCOVERED_GAIN on foreground, 0 where unsure or where the other blobs (cast
+    pixel by pixel) already cover it."""
+    sk = human_template()
+    g = Kinematics(sk, _rest(sk)).segments
+    A, C = raycast.blob_frames(sk.blobs, g)
+    view = _rest(sk).views[0]
+    fg = np.random.default_rng(5).choice([BACKDROP, FOREGROUND, UNSURE], BODY).astype(np.uint8)
+    rest = np.arange(len(sk.blobs)) % 2 == 0  # every other blob stays
+    box = (40, 30, 300, 350)
+    S = LimbSearch._gain_sums(view, fg, A[rest], C[rest], box)
+    ys, xs = np.mgrid[box[1]:box[3], box[0]:box[2]]
+    pix = np.stack([xs.ravel(), ys.ravel()], 1).astype(float)
+    others = raycast.cast(view, pix, [b for b, r in zip(sk.blobs, rest) if r], g).label >= 0
+    code = fg[box[1]:box[3], box[0]:box[2]].ravel()
+    cost = np.where(code == BACKDROP, 1.0, np.where(code == FOREGROUND, -UNCOVERED_GAIN, 0.0))
+    cost[others] = 0.0
+    cost = cost.reshape(ys.shape)
+    assert others.sum() > 1000
+    wrong = np.abs(np.diff(S, axis=1) - cost) > 1e-9
+    assert wrong.sum() <= 6  # round-off on the rim of the blobs' outlines
+
+
 def test_outline_sums_count_each_pixel_of_overlapping_blobs_once():
     sk = human_template()
     pose = _rest(sk)
