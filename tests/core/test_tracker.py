@@ -13,6 +13,7 @@ from core.scales import REFERENCE_BODY_PIXELS, view_octaves
 from core.settings import TrackerSettings
 from core.side_on import BODY, TURNED, depth_blind_joints, side_on_skeleton, turned_from
 from core.skeleton import HINGE, human_template
+from core.solver import DegenerateSystem
 from core.tracker import Tracker, track
 from support.synthetic import render, side_pinhole, side_view
 
@@ -711,3 +712,28 @@ def test_a_frame_is_tracked_and_learned_from_on_one_blas_thread(body, monkeypatc
         calls[1](before)
     assert between == [2, 2, 2]
     assert inside == [("track_frame", 1), ("_learn_backdrops", 1)] * 2
+
+
+def test_a_frame_whose_system_cannot_be_solved_keeps_its_prediction_and_stops_the_run(
+        body, monkeypatch):
+    """A degenerate system (no usable pixels) ends the frame as diverged, with the reason and
+    the predicted pose (the one it would have started from), and the run stops there; the
+    frames before it are kept."""
+    sk, pose = body
+    tracker = Tracker(sk, [[render(sk, pose, c)] * 4 for c in range(3)], CALIBRATED)
+    fit = tracker.track_frame
+    started = {}
+
+    def fails_on_frame_2(prev, prev_frame, key, key_frame, predicted, frame, *rest):
+        if frame == 2:
+            started[frame] = predicted
+            raise DegenerateSystem("no usable pixels in any view")
+        return fit(prev, prev_frame, key, key_frame, predicted, frame, *rest)
+
+    monkeypatch.setattr(tracker, "track_frame", fails_on_frame_2)
+    res = track(tracker, pose, range(4))
+    assert [f.frame for f in res.frames] == [0, 1, 2]
+    last = res.frames[-1]
+    assert last.diverged and "no usable pixels" in last.reason and res.diverged_frames == [2]
+    np.testing.assert_array_equal(last.pose.rotations, started[2].rotations)
+    assert not res.frames[1].diverged
