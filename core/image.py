@@ -58,11 +58,12 @@ def grey_and_colour(source) -> tuple[np.ndarray, np.ndarray | None]:
 
 def check_footage(paths, where: str) -> None:
     """ImageError naming the first of the image files ``paths`` (str or Path; other sources,
-    a movie's frames or arrays, are not checked) that cannot be decoded, or that differs in
-    size from the first, before any is tracked: a file cut short in the middle of a sequence
-    must not stop a run half way, and frames of one view are one camera's (cells cropped
-    each its own way are not). The files are decoded on every core (the decoder releases
-    the interpreter's lock); its own complaints are kept off the terminal."""
+    a movie's frames or arrays, are not checked) that cannot be decoded (a JPEG cut short
+    among them: the decoder would fill it out with grey), or that differs in size from the
+    first, before any is tracked: a file cut short in the middle of a sequence must neither
+    stop a run half way nor be tracked as it is, and frames of one view are one camera's
+    (cells cropped each its own way are not). The files are decoded on every core (the
+    decoder releases the interpreter's lock); its own complaints are kept off the terminal."""
     paths = getattr(paths, "source", paths)  # footage read undistorted: its files
     files = [p for p in paths if isinstance(p, (str, Path))]
     if not files:
@@ -89,9 +90,53 @@ def check_footage(paths, where: str) -> None:
 
 
 def _decoded_shape(path) -> tuple[int, int] | None:
-    """(height, width) of an image file, decoded whole; None if it cannot be."""
-    img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    """(height, width) of an image file, decoded whole; None if it cannot be, or if it is a
+    JPEG cut short (which the decoder fills out with grey, only warning)."""
+    try:
+        data = np.fromfile(path, np.uint8)
+    except OSError:
+        return None
+    if Path(path).suffix.lower() in (".jpg", ".jpeg") and not jpeg_ends(data.tobytes()):
+        return None
+    img = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE)
     return None if img is None else img.shape
+
+
+def jpeg_ends(data: bytes) -> bool:
+    """Whether a JPEG file's segments run through to its end-of-image marker, as they do
+    unless the file was cut short (a copy or download stopped part way). Each marker's
+    segment is stepped over by its length; after a start of scan, the coded data runs to
+    the next marker (0xFF not followed by a stuffed 0x00 or a restart marker). What comes
+    after the end (some cameras append data) is not read; data that does not start as a
+    JPEG is left to the decoder (True)."""
+    if data[:2] != b"\xff\xd8":
+        return True
+    i, n = 2, len(data)
+    while True:
+        if i >= n:
+            return False  # the data ends before its end marker
+        if data[i] != 0xFF:
+            return True  # not a marker where one should be: for the decoder to judge
+        while i < n and data[i] == 0xFF:  # fill bytes before a marker
+            i += 1
+        if i >= n:
+            return False
+        marker, i = data[i], i + 1
+        if marker == 0xD9:
+            return True
+        if 0xD0 <= marker <= 0xD7 or marker == 0x01:  # no segment follows
+            continue
+        if i + 2 > n:
+            return False
+        i += int.from_bytes(data[i:i + 2], "big")
+        if marker == 0xDA:  # coded data up to the next marker
+            while True:
+                i = data.find(b"\xff", i)
+                if i < 0 or i + 1 >= n:
+                    return False
+                if data[i + 1] != 0x00 and not 0xD0 <= data[i + 1] <= 0xD7:
+                    break
+                i += 2
 
 
 class quiet_stderr:

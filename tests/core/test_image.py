@@ -56,3 +56,36 @@ def test_load_grey_reads_files_and_names_bad_ones(tmp_path):
     np.testing.assert_allclose(image.load_grey(path), 1.0)
     with pytest.raises(image.ImageError, match="missing.png"):
         image.load_grey(tmp_path / "missing.png")
+
+
+JPEG_KINDS = pytest.mark.parametrize("params", [[], [cv2.IMWRITE_JPEG_PROGRESSIVE, 1],
+                                                [cv2.IMWRITE_JPEG_RST_INTERVAL, 4]],
+                                     ids=["baseline", "progressive", "restart markers"])
+
+
+@JPEG_KINDS
+def test_a_jpeg_ends_whole_and_not_when_cut_short_anywhere(params):
+    """Every cut of an encoded JPEG, in its headers or its coded data, stops before the end
+    marker; the whole file reaches it, with data after it (some cameras append their own)
+    or not."""
+    img = (np.random.default_rng(0).random((60, 80, 3)) * 255).astype(np.uint8)
+    data = cv2.imencode(".jpg", img, params)[1].tobytes()
+    assert image.jpeg_ends(data)
+    assert image.jpeg_ends(data + b"\xff\xda\x00\x10appended by a camera")
+    assert not any(image.jpeg_ends(data[:k]) for k in range(2, len(data) - 1))
+    assert not image.jpeg_ends(data[:-2])  # all but the end marker
+
+
+@JPEG_KINDS
+def test_the_footage_check_names_a_jpeg_cut_short_which_the_decoder_fills_with_grey(
+        tmp_path, params):
+    img = (np.random.default_rng(1).random((60, 80, 3)) * 255).astype(np.uint8)
+    data = cv2.imencode(".jpg", img, params)[1].tobytes()
+    paths = [tmp_path / f"{f:03d}.jpg" for f in range(4)]
+    for f, path in enumerate(paths):
+        path.write_bytes(data if f != 2 else data[:len(data) // 2])
+    with image.quiet_stderr():  # the decoder's warning
+        assert cv2.imread(str(paths[2])) is not None  # it decodes, half of it grey
+    image.check_footage(paths[:2], "view 1's footage")
+    with pytest.raises(image.ImageError, match="002.jpg: cannot read this image"):
+        image.check_footage(paths, "view 1's footage")
