@@ -93,12 +93,12 @@ def _decoded_shape(path) -> tuple[int, int] | None:
     """(height, width) of an image file, decoded whole; None if it cannot be, or if it is a
     JPEG cut short (which the decoder fills out with grey, only warning)."""
     try:
-        data = np.fromfile(path, np.uint8)
+        data = Path(path).read_bytes()
     except OSError:
         return None
-    if Path(path).suffix.lower() in (".jpg", ".jpeg") and not jpeg_ends(data.tobytes()):
+    if Path(path).suffix.lower() in (".jpg", ".jpeg") and not jpeg_ends(data):
         return None
-    img = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE)
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
     return None if img is None else img.shape
 
 
