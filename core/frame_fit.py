@@ -17,10 +17,12 @@ before refining, each limb is searched over a grid of turns against the silhouet
 (``core.search``), a turn kept where every view's pixels bear it out (the earlier frame's,
 or in two views or more the key frame's), or where two or more views' backdrops show that
 the limb cannot be where it is and can be where it turned. The finished frame's limbs are
-checked against every view (``core.confidence``). Sizes in pixels are meant for a body about
-``REFERENCE_BODY_PIXELS`` tall; where a view shows it several times that, that view's
-pyramid gets finer levels on top, sampled as sparsely, and each tracker level reads every
-view where the body is about as large (``auto_scale``, ``core.scales``).
+checked against every view (``core.confidence``); a limb flagged there leaves out, on the
+next frame, its pixels that the backdrop showed to be backdrop (``release_lost_limbs``).
+Sizes in pixels are meant for a body about ``REFERENCE_BODY_PIXELS`` tall; where a view
+shows it several times that, that view's pyramid gets finer levels on top, sampled as
+sparsely, and each tracker level reads every view where the body is about as large
+(``auto_scale``, ``core.scales``).
 """
 
 from __future__ import annotations
@@ -62,6 +64,9 @@ from .solver import (
 )
 
 SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
+# level pixels from any pixel that may be the body past which a lost limb's pixel of the
+# frame before is taken for backdrop (``release_lost_limbs``)
+LOST_REACH = 1.5
 
 
 @dataclass(kw_only=True)
@@ -421,7 +426,11 @@ class FrameFit:
 
     # --- point sets ---------------------------------------------------------------------
     def point_set(self, pose: BodyPose, kin: Kinematics, view: int, frame: int, lv: int,
-                  set_weight: float) -> PointSet:
+                  set_weight: float, lost: Collection[str] = ()) -> PointSet:
+        """The body's pixels of ``frame`` in ``view`` at ``pose`` on the view's pyramid level
+        ``lv`` (every grid-th pixel), each with its segment's frame point, brightness and
+        weight. ``lost``: limbs whose pixels the view's still backdrop shows to be backdrop on
+        ``frame`` are left out (``_backdrop_pixels``)."""
         level = self.seq.pyramid(view, frame)[lv]
         step = self.scales.grid(view, lv)
         v_l = pose.views[view].at_level(lv)
@@ -429,6 +438,8 @@ class FrameFit:
             v_l, self._blobs, kin.segments, level.shape, step
         )
         ok = hits.label >= 0
+        if lost and self._cue.has(view):
+            ok &= ~self._backdrop_pixels(view, frame, lv, pix_l, hits.label, lost)
         pix_l, label = pix_l[ok].astype(int), hits.label[ok]
         seg_joint = self._blobs.joint[label]
         g = kin.segments[seg_joint]
@@ -437,6 +448,22 @@ class FrameFit:
         value = level.stack[pix_l[:, 1], pix_l[:, 0], 0].astype(float)
         rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
         return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
+
+    def _backdrop_pixels(self, view: int, frame: int, lv: int, pix: np.ndarray,
+                         blob: np.ndarray, lost: Collection[str]) -> np.ndarray:
+        """Which level pixels ``pix`` (N, 2) of blobs ``blob`` (N,; -1: none) belong to a limb
+        in ``lost`` and lie over ``LOST_REACH`` level pixels from any pixel of ``frame`` that
+        may be the body (foreground or unsure on its map): a limb lost onto a textured
+        backdrop would be held there by those pixels, which do not move."""
+        limb = np.append(np.isin(self._limbs.names, list(lost)), False)[
+            np.where(blob >= 0, self._limbs.of_blob[blob], -1)]
+        if not limb.any():
+            return limb
+        far = sil.distance_to_body(self._cue.foreground(view, frame, lv))
+        out = np.zeros(len(blob), bool)
+        px = pix[limb].astype(int)
+        out[limb] = far[px[:, 1], px[:, 0]] > LOST_REACH
+        return out
 
     def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int,
                    grid: int) -> tuple[np.ndarray, raycast.LabelGrid]:
@@ -657,7 +684,8 @@ class FrameFit:
             levels = [self.seq.pyramid(c, frame)[lv] for c, lv in enumerate(lvs)]
             sets = []  # per view, the previous frame's points then the key frame's
             for c, lv in enumerate(lvs):
-                view_sets = [self.point_set(prev, kin_prev, c, prev_frame, lv, 1.0)]
+                view_sets = [self.point_set(prev, kin_prev, c, prev_frame, lv, 1.0,
+                                            doubted if s.release_lost_limbs else ())]
                 if s.key_weight > 0 and key_frame != prev_frame:
                     k = (key_frame, c, lv)
                     if k not in self.key_sets:

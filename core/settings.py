@@ -74,6 +74,11 @@ class TrackerSettings:
                                "more views' backdrops show the limb cannot be where it is and "
                                "can be where it turned (0: off). Catches limbs faster than a "
                                "blob's width a frame")
+    release_lost_limbs: bool = _knob(True, "A limb flagged on the frame before leaves out "
+                                     "its pixels of that frame that the view's still "
+                                     "backdrop shows were backdrop: a limb lost onto a "
+                                     "textured backdrop is otherwise held there by the "
+                                     "backdrop's own pixels, which do not move")
 
     def __post_init__(self):
         for name in ("levels", "iterations", "pixel_step"):

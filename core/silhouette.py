@@ -368,10 +368,11 @@ class SilhouetteCue:
         # per view; None: not started
         self.backdrops: list[Backdrop | TurningBackdrop | None] | None = None
         self._foregrounds: dict[tuple[int, int], LevelMaps] = {}  # (view, frame)
+        self._recent: list[int] = []  # the frames whose foregrounds are kept, latest last
 
     def reset(self) -> None:
         """Forget the backdrops (a new key pose, or a new size of the body's pyramids)."""
-        self.backdrops, self._foregrounds = None, {}
+        self.backdrops, self._foregrounds, self._recent = None, {}, []
 
     @property
     def started(self) -> bool:
@@ -445,9 +446,13 @@ class SilhouetteCue:
 
     def foreground(self, view: int, frame: int, level: int = 0) -> np.ndarray:
         """Foreground map of ``frame`` in ``view`` (one that ``has``) on pyramid level
-        ``level`` (``LevelMaps``; 0: full resolution); only one frame's are kept."""
+        ``level`` (``LevelMaps``; 0: full resolution); the two frames' last asked for are
+        kept (the frame being tracked and the one before it)."""
+        if self._recent[-1:] != [frame]:
+            self._recent = [f for f in self._recent if f != frame][-1:] + [frame]
+            self._foregrounds = {k: v for k, v in self._foregrounds.items()
+                                 if k[1] in self._recent}
         if (view, frame) not in self._foregrounds:
-            self._foregrounds = {k: v for k, v in self._foregrounds.items() if k[1] == frame}
             bd = self.backdrops[view]
             seen = (self.seq.grey(view, frame), self.seq.colour(view, frame))
             self._foregrounds[view, frame] = LevelMaps(bd.foreground(frame, *seen) if isinstance(

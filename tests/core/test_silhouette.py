@@ -418,3 +418,54 @@ def test_a_clean_plate_for_a_camera_that_moves_is_refused():
     with pytest.raises(InputError, match="view 1's camera moves, so one still image of its "
                                          "scene cannot be its clean plate"):
         Tracker(sk, [frames], CALIBRATED, moving=[path], clean_plates=[frames[0]])
+
+
+def test_a_frames_maps_and_the_frame_befores_are_kept_and_no_more():
+    rng = np.random.default_rng(1)
+    shape = (90, 120)
+    wall = cv2.GaussianBlur(rng.uniform(0, 1, shape).astype(np.float32), (0, 0), 2)
+    bodies = [_disc(shape, (30 + 10 * f, 45), 12) for f in range(6)]
+    frames = [np.where(b, 0.95, wall).astype(np.float32) for b in bodies]
+    cue = SilhouetteCue(ImageSequence([frames], 1))
+    assert cue.start(0, [bodies[0]], [3], np.array([0.0, 0.0, 5.0])) == []
+    two, three = cue.foreground(0, 2), cue.foreground(0, 3)
+    assert cue.foreground(0, 2) is two and cue.foreground(0, 3) is three
+    cue.foreground(0, 4)
+    assert cue.foreground(0, 3) is three
+    again = cue.foreground(0, 2)  # made anew: frames 3 and 4 were asked for since
+    assert again is not two
+    np.testing.assert_array_equal(again, two)
+
+
+@pytest.mark.parametrize("release", [True, False])
+def test_a_lost_limb_is_not_held_on_a_still_backdrop_by_the_backdrops_pixels(release):
+    """A chain held still before a textured wall, its last link tracked 50 degrees off on
+    the frame before, onto the wall, and flagged there: that link's pixels of that frame
+    are the wall's, which stays where it is, so they would hold the link where it was lost.
+    The backdrop shows them to be the wall, and they are left out: the key frame's pixels
+    and the outline bring the link back. Kept (``release_lost_limbs`` off), they hold it."""
+    sk = planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1))
+    for b in sk.blobs:
+        b.radii[1:] = 0.05
+    view = side_view(yaw_deg=0, height=0.0, center=(110, 180))
+    truth = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3), [view])
+    lost = apply_update(sk, truth, np.radians([0, 0, 0, 0, 0, 0, 0, 0, 50]), INDEPENDENT)
+    rng = np.random.default_rng(4)
+    wall = cv2.GaussianBlur(rng.uniform(0, 1, (360, 320)).astype(np.float32), (0, 0), 3)
+    wall = 0.1 + 0.8 * (wall - wall.min()) / np.ptp(wall)
+    body = render(sk, truth, 0, background=np.nan)
+    frames = [[(np.where(np.isnan(body), wall, body)
+                + rng.normal(0, 0.01, wall.shape)).astype(np.float32) for _ in range(6)]]
+
+    def last_link_off(pose):
+        a, b = (sk.joint_frames(p.rotations, p.root_position)[-1, :3, 0]
+                for p in (pose, truth))
+        return np.degrees(se3.angle_between_vectors(a, b))
+
+    tracker = Tracker(sk, frames, INDEPENDENT, TrackerSettings(release_lost_limbs=release))
+    pose, doubted = lost, {sk.names[-1]}
+    for k in range(2, 6):
+        res = tracker.track_frame(pose, k - 1, truth, 0, pose, k, doubted)
+        pose, doubted = res.pose, {n for n, c in res.limbs.items() if c.flag}
+    assert last_link_off(lost) > 45
+    assert (last_link_off(pose) < 35) if release else (last_link_off(pose) > 45)
