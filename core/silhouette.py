@@ -446,8 +446,8 @@ class SilhouetteCue:
 
     def foreground(self, view: int, frame: int, level: int = 0) -> np.ndarray:
         """Foreground map of ``frame`` in ``view`` (one that ``has``) on pyramid level
-        ``level`` (``LevelMaps``; 0: full resolution); the two frames' last asked for are
-        kept (the frame being tracked and the one before it)."""
+        ``level`` (``LevelMaps``; 0: full resolution); the maps of the last two frames asked
+        for are kept (the frame being tracked and the one before it)."""
         if self._recent[-1:] != [frame]:
             self._recent = [f for f in self._recent if f != frame][-1:] + [frame]
             self._foregrounds = {k: v for k, v in self._foregrounds.items()
