@@ -321,12 +321,12 @@ class FrameFit:
         return seen if seen and (clear == seen or (seen > 1 and vouched == seen)) else 0
 
     def _evidenced(self, est: BodyPose, searched: BodyPose, turned: list[str],
-                   sets: list[PointSet], levels: list, level: int, searched_on: tuple = ()
-                   ) -> tuple[BodyPose, list[str]]:
-        """``est`` with the turns of ``searched`` that the footage bears out, and the joints
-        so turned where two or more views bore the turn out (``FrameResult.searched``);
-        ``searched_on``: the views the search read and their foreground maps
-        (``_search_limbs``').
+                   sets: list[PointSet], levels: list, level: int, frame: int,
+                   searched_on: tuple = ()) -> tuple[BodyPose, list[str]]:
+        """``est`` with the turns of ``searched`` that the footage bears out on ``frame``, and
+        the joints so turned where two or more views bore the turn out
+        (``FrameResult.searched``); ``searched_on``: the views the search read on tracker
+        level ``level`` and their foreground maps (``_search_limbs``').
         Parents first, a limb's turn is kept when the backdrops refute the limb where it is
         and bear it out turned, with the limbs below it (``_refuted_chain``), or when, in
         every view that sees the limb, its pixels of the earlier frames match the new image
@@ -346,8 +346,9 @@ class FrameFit:
         backdrops = ()  # the search's views (``searched_on``) with their distance maps
         if searched_on:
             views, fgs = searched_on
-            backdrops = (views, [None if fg is None else sil.distance_to_body(fg)
-                                 for fg in fgs])
+            lvs = self.scales.view_levels(level)
+            backdrops = (views, [None if fg is None else self._cue.distance_to_body(c, frame, lv)
+                                 for c, (fg, lv) in enumerate(zip(fgs, lvs))])
         out, kept = est, []
         for limb in self._search.limbs:
             if self.skeleton.names[limb.joint] not in turned:
@@ -459,7 +460,7 @@ class FrameFit:
             np.where(blob >= 0, self._limbs.of_blob[blob], -1)]
         if not limb.any():
             return limb
-        far = sil.distance_to_body(self._cue.foreground(view, frame, lv))
+        far = self._cue.distance_to_body(view, frame, lv)
         out = np.zeros(len(blob), bool)
         px = pix[limb].astype(int)
         out[limb] = far[px[:, 1], px[:, 0]] > LOST_REACH
@@ -698,7 +699,8 @@ class FrameFit:
                 searched, turned, searched_on = self._search_limbs(est, frame, key, key_frame)
                 if turned:
                     searched, searched_joints = self._evidenced(est, searched, turned, sets,
-                                                                levels, level, searched_on)
+                                                                levels, level, frame,
+                                                                searched_on)
                 if searched is not est:  # the prediction from here on (what prior holds to)
                     est, offset = searched, np.zeros(self.n_params)
                     kin = Kinematics(self.skeleton, est)

@@ -255,6 +255,13 @@ class LevelMaps:
         self._shares = {code: [(fg == code).astype(np.float32)] for code in (FOREGROUND, UNSURE)
                         if code == FOREGROUND or np.any(fg == UNSURE)}
         self._maps: dict[int, np.ndarray] = {}
+        self._distances: dict[int, np.ndarray] = {}
+
+    def distance(self, level: int) -> np.ndarray:
+        """``distance_to_body`` of the map on ``level``, made once."""
+        if level not in self._distances:
+            self._distances[level] = distance_to_body(self.at(level))
+        return self._distances[level]
 
     def at(self, level: int) -> np.ndarray:
         """The map on pyramid level ``level`` (0: the full-resolution map's codes)."""
@@ -448,6 +455,14 @@ class SilhouetteCue:
         """Foreground map of ``frame`` in ``view`` (one that ``has``) on pyramid level
         ``level`` (``LevelMaps``; 0: full resolution); the maps of the last two frames asked
         for are kept (the frame being tracked and the one before it)."""
+        return self._maps(view, frame).at(level)
+
+    def distance_to_body(self, view: int, frame: int, level: int = 0) -> np.ndarray:
+        """``distance_to_body`` of ``foreground``'s map, kept with it."""
+        return self._maps(view, frame).distance(level)
+
+    def _maps(self, view: int, frame: int) -> LevelMaps:
+        """``frame``'s foreground maps in ``view``, made when first asked for."""
         if self._recent[-1:] != [frame]:
             self._recent = [f for f in self._recent if f != frame][-1:] + [frame]
             self._foregrounds = {k: v for k, v in self._foregrounds.items()
@@ -457,7 +472,7 @@ class SilhouetteCue:
             seen = (self.seq.grey(view, frame), self.seq.colour(view, frame))
             self._foregrounds[view, frame] = LevelMaps(bd.foreground(frame, *seen) if isinstance(
                 bd, TurningBackdrop) else bd.foreground(*seen))
-        return self._foregrounds[view, frame].at(level)
+        return self._foregrounds[view, frame]
 
     def unseen(self, view: int) -> bool:
         """Whether ``view``'s backdrop can still learn from a tracked frame."""
