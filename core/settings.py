@@ -22,7 +22,8 @@ class TrackerSettings:
     levels: int = _knob(3, "Pyramid levels, coarse to fine (1: full resolution only)")
     highpass: float = _knob(4.0, "Shading removal: subtract the local mean over this many "
                             "pixels of each level (0: off)")
-    iterations: int = _knob(6, "Gauss-Newton iterations per pyramid level, at most")
+    iterations: int = _knob(6, "Gauss-Newton iterations per pyramid level, at most (half as "
+                            "many where each view has its own scaled camera: independent mode)")
     pixel_step: int = _knob(2, "Use every n-th pixel across and down on the finest level")
     auto_scale: bool = _knob(True, "Fit the settings counted in pixels to the body's size in "
                              "each view: where it stands over about 280 pixels tall, that "
