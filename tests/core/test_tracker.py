@@ -90,6 +90,20 @@ def test_recovers_a_known_small_motion_in_three_views(body, mode):
             assert err < 0.3  # pixels
 
 
+@pytest.mark.parametrize("mode, per_level", [(CALIBRATED, 6), (INDEPENDENT, 3)])
+def test_a_level_iterates_up_to_the_setting_and_independent_views_half_as_many(
+        body, mode, per_level):
+    """Never converged (no motion is small enough), every level runs to its cap: the
+    setting, or half of it where each view solves its own scaled camera (its scale drifts
+    with every step its pixels do not pin)."""
+    sk, pose = body
+    moved = apply_update(sk, pose, _small_motion(sk, mode, 3, seed=4), mode)
+    frames = [[render(sk, pose, c), render(sk, moved, c, noise=0.01, seed=c)] for c in range(3)]
+    tracker = Tracker(sk, frames, mode, TrackerSettings(iterations=6, converge_pixels=0.0))
+    res = track(tracker, pose, [0, 1])
+    assert res.frames[1].iterations == per_level * tracker.scales.n_levels()
+
+
 def _enlarged(pose: BodyPose, factor: float) -> BodyPose:
     """The same pose seen by the same cameras on footage ``factor`` times the size (pixel
     i of the original is pixel factor * i of the new one, as a pyramid level is)."""
