@@ -23,6 +23,10 @@ from . import se3
 from .bvh import BvhFile
 
 BALL, HINGE, FIXED = "ball", "hinge", "fixed"
+# default blobs (``Skeleton.default_blobs``), in parts of the body's height
+TRUNK_RADIUS = 0.065  # a trunk bone's least radius: an adult's, as the human template has it
+GIRDLE_LENGTH = 0.12  # a bone from the trunk shorter than this is the trunk's
+LIMB_REACH = 0.25  # end sites this near a joint all its subtree is near are one limb's
 
 
 @dataclass
@@ -219,8 +223,13 @@ class Skeleton:
 
         Long radius half the bone, short radii max(radius_ratio * length,
         min_radius_ratio * height); bones shorter than min_length_ratio * height get none.
-        """
+        The trunk is the body's widest part, but a capture cuts it into short bones (a spine
+        of three or four, a pelvis and a shoulder girdle of a bone a side), which the length
+        rule makes rods, and foreground the rods leave uncovered lures the arms onto the
+        trunk: a trunk bone's (``trunk_bones``) short radii are ``TRUNK_RADIUS`` of the
+        height at least."""
         H = self.height()
+        trunk = self.trunk_bones()
         blobs = []
         for j in range(self.n_joints):
             tips = [self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
@@ -230,8 +239,43 @@ class Skeleton:
                     continue
                 r = max(radius_ratio * L, min_radius_ratio * H)
                 name = self.names[j] if len(tips) == 1 else f"{self.names[j]}.{k}"
-                blobs.append(bone_blob(j, name, self.rest_positions[j], d, r))
+                blob = bone_blob(j, name, self.rest_positions[j], d, r)
+                if trunk[j, k]:
+                    blob.radii[1:] = np.maximum(blob.radii[1:], TRUNK_RADIUS * H)
+                blobs.append(blob)
         return blobs
+
+    def limbs_below(self) -> np.ndarray:
+        """Per joint, how many limbs hang from it: the end sites of its subtree grouped, one
+        group for every end site reached within ``LIMB_REACH`` of the height of a joint all
+        of whose subtree is that near (a hand's fingers, a foot's toe and heel are one)."""
+        near = LIMB_REACH * self.height()
+        J = self.n_joints
+        reach, limbs = np.zeros(J), np.zeros(J, int)
+        for j in reversed(range(J)):  # children after their parents: the deepest first
+            kids = self.children(j)
+            ends = [float(np.linalg.norm(e)) for e in self.end_sites[j]]
+            reach[j] = max([reach[c] + float(np.linalg.norm(self.offsets[c])) for c in kids]
+                           + ends, default=0.0)
+            limbs[j] = 1 if reach[j] <= near else sum(limbs[c] for c in kids) + len(ends)
+        return limbs
+
+    def trunk_bones(self) -> np.ndarray:
+        """Boolean (J, most tips) per joint and tip (its children, then its end sites, as
+        ``default_blobs`` counts them): the trunk's bones, those of a joint three or more
+        limbs hang from (``limbs_below``), and the short ones (under ``GIRDLE_LENGTH`` of
+        the height) from such a joint to a limb: a pelvis's or shoulder girdle's half, the
+        neck's base."""
+        H, limbs = self.height(), self.limbs_below()
+        tips = [[self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
+                for j in range(self.n_joints)]
+        out = np.zeros((self.n_joints, max(map(len, tips), default=0)), bool)
+        for j, ds in enumerate(tips):
+            p = self.parents[j]
+            for k, d in enumerate(ds):
+                out[j, k] = limbs[j] >= 3 or (p >= 0 and limbs[p] >= 3
+                                              and np.linalg.norm(d) < GIRDLE_LENGTH * H)
+        return out
 
 
 def bone_blob(joint: int, name: str, head: np.ndarray, direction: np.ndarray, r) -> Ellipsoid:

@@ -8,6 +8,8 @@ from core.bvh import read_bvh
 from core.skeleton import (
     BALL,
     HINGE,
+    TRUNK_RADIUS,
+    Skeleton,
     human_template,
     planar_chain_template,
     planar_quadruped_template,
@@ -112,6 +114,40 @@ def test_default_blobs_span_their_bones():
     assert b.radii[0] == pytest.approx(np.linalg.norm(tip - knee) / 2)
     np.testing.assert_allclose(np.abs(b.Q[:, 0]), [0, 1, 0], atol=1e-12)
     np.testing.assert_allclose(b.Q.T @ b.Q, np.eye(3), atol=1e-12)
+
+
+def test_limbs_are_counted_where_their_end_sites_part():
+    # a trunk carrying a head and two arms, each arm ending in a hand of two fingers: the
+    # fingers part 0.05 from their ends (one limb), the arms 0.6 (two), the head 0.3
+    offsets = [(0, 0, 0), (0, 0.5, 0), (0.2, 0, 0), (0.5, 0, 0), (-0.2, 0, 0), (-0.5, 0, 0)]
+    sk = Skeleton(names=["hips", "chest", "l_arm", "l_hand", "r_arm", "r_hand"],
+                  parents=[-1, 0, 1, 2, 1, 4], offsets=offsets,
+                  end_sites=[[], [(0, 0.3, 0)], [], [(0.05, 0, 0), (0.05, 0.02, 0)], [],
+                             [(-0.05, 0, 0), (-0.05, 0.02, 0)]])
+    assert sk.height() == pytest.approx(1.5)  # so a limb's end sites part within 0.375
+    np.testing.assert_array_equal(sk.limbs_below(), [3, 3, 1, 1, 1, 1])
+
+
+def test_default_blobs_make_the_trunk_as_thick_as_a_trunk(cmu_walk):
+    sk = skeleton_from_bvh(read_bvh(cmu_walk))
+    H = sk.height()
+    blobs = {b.name: b for b in sk.default_blobs()}
+    # the spine (three limbs above it) and the short bones from the trunk to the legs and
+    # to the neck: at least an adult trunk's radius across, half the bone long
+    for name, child in (("lowerback", "Chest"), ("Chest", "Chest2"), ("LHipJoint", "LeftHip"),
+                        ("RHipJoint", "RightHip"), ("lowerneck", "Neck")):
+        L = np.linalg.norm(sk.offsets[sk.index(child)])
+        assert blobs[name].radii[0] == pytest.approx(L / 2), name
+        assert np.all(blobs[name].radii[1:] >= TRUNK_RADIUS * H - 1e-12), name
+    # a limb's bones keep the length rule: half the bone long, 0.16 of it across
+    for name, child in (("LeftHip", "LeftKnee"), ("LeftShoulder", "LeftElbow"),
+                        ("LeftCollar", "LeftShoulder"), ("Head", None)):
+        j = sk.index(name)
+        L = np.linalg.norm(sk.offsets[sk.index(child)] if child else sk.end_sites[j][0])
+        np.testing.assert_allclose(blobs[name].radii, [L / 2] + [max(0.16 * L, 0.022 * H)] * 2)
+    limbs = sk.limbs_below()
+    assert limbs[sk.index("Hips")] == 5 and limbs[sk.index("Chest2")] == 3
+    assert limbs[sk.index("LeftWrist")] == 1 and limbs[sk.index("Neck")] == 1
 
 
 def test_parents_must_precede_children():
