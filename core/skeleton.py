@@ -23,7 +23,11 @@ from . import se3
 from .bvh import BvhFile
 
 BALL, HINGE, FIXED = "ball", "hinge", "fixed"
-# default blobs (``Skeleton.default_blobs``), in parts of the body's height
+# default blobs (``Skeleton.default_blobs``): short radii in parts of a bone's length
+# (LENGTH_RADIUS), the rest in parts of the body's height
+LENGTH_RADIUS = 0.16
+MIN_RADIUS = 0.022  # any bone's least radius
+MIN_LENGTH = 0.03  # a shorter bone gets no blob
 TRUNK_RADIUS = 0.065  # a trunk bone's least radius: an adult's, as the human template has it
 GIRDLE_LENGTH = 0.12  # a bone from the trunk shorter than this is the trunk's
 LIMB_REACH = 0.25  # end sites this near a joint all its subtree is near are one limb's
@@ -216,34 +220,38 @@ class Skeleton:
         return self.joint_frames(rotations, root_position, offsets)[:, :3, 3]
 
     # --- blobs ------------------------------------------------------------------------
-    def default_blobs(
-        self, radius_ratio: float = 0.16, min_radius_ratio: float = 0.022, min_length_ratio=0.03
-    ) -> list[Ellipsoid]:
-        """One ellipsoid per bone (joint to child or end site) long enough to see.
-
-        Long radius half the bone, short radii max(radius_ratio * length,
-        min_radius_ratio * height); bones shorter than min_length_ratio * height get none.
-        The trunk is the body's widest part, but a capture cuts it into short bones (a spine
-        of three or four, a pelvis and a shoulder girdle of a bone a side), which the length
-        rule makes rods, and foreground the rods leave uncovered lures the arms onto the
-        trunk: a trunk bone's (``trunk_bones``) short radii are ``TRUNK_RADIUS`` of the
-        height at least."""
+    def default_blobs(self) -> list[Ellipsoid]:
+        """One ellipsoid per bone (joint to child or end site) long enough to see: long radius
+        half the bone, short radii ``blob_radii``'s; bones shorter than ``MIN_LENGTH`` of
+        the height get none."""
         H = self.height()
-        trunk = self.trunk_bones()
-        blobs = []
-        for j in range(self.n_joints):
-            tips = [self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
-            for k, d in enumerate(tips):
-                L = float(np.linalg.norm(d))
-                if L < min_length_ratio * H:
-                    continue
-                r = max(radius_ratio * L, min_radius_ratio * H)
-                name = self.names[j] if len(tips) == 1 else f"{self.names[j]}.{k}"
-                blob = bone_blob(j, name, self.rest_positions[j], d, r)
-                if trunk[j, k]:
-                    blob.radii[1:] = np.maximum(blob.radii[1:], TRUNK_RADIUS * H)
-                blobs.append(blob)
-        return blobs
+        bones = [(j, k, d) for j in range(self.n_joints)
+                 for k, d in enumerate([self.offsets[c] for c in self.children(j)]
+                                       + list(self.end_sites[j]))
+                 if np.linalg.norm(d) >= MIN_LENGTH * H]
+        radii = self.blob_radii([(j, d) for j, _, d in bones])
+        n_tips = [len(self.children(j)) + len(self.end_sites[j]) for j in range(self.n_joints)]
+        return [bone_blob(j, self.names[j] if n_tips[j] == 1 else f"{self.names[j]}.{k}",
+                          self.rest_positions[j], d, r)
+                for (j, k, d), r in zip(bones, radii)]
+
+    def blob_radii(self, bones: list[tuple[int, np.ndarray]]) -> np.ndarray:
+        """The default short radius of each bone (joint j, the vector d from it to the bone's
+        tip): ``LENGTH_RADIUS`` of its length, ``MIN_RADIUS`` of the body's height at
+        least. The trunk is the body's widest part, but a capture cuts it into short bones
+        (a spine of three or four, a pelvis and a shoulder girdle of a bone a side), which
+        that rule makes rods, and foreground the rods leave uncovered lures the arms onto
+        the trunk: a trunk bone, of a joint three or more limbs hang from
+        (``limbs_below``) or a short one (under ``GIRDLE_LENGTH`` of the height) from such
+        a joint to a limb (a pelvis's or shoulder girdle's half, the neck's base), is
+        ``TRUNK_RADIUS`` of the height at least."""
+        H, limbs = self.height(), self.limbs_below()
+        out = np.empty(len(bones))
+        for i, (j, d) in enumerate(bones):
+            L, p = float(np.linalg.norm(d)), self.parents[j]
+            trunk = limbs[j] >= 3 or (p >= 0 and limbs[p] >= 3 and L < GIRDLE_LENGTH * H)
+            out[i] = max(LENGTH_RADIUS * L, (TRUNK_RADIUS if trunk else MIN_RADIUS) * H)
+        return out
 
     def limbs_below(self) -> np.ndarray:
         """Per joint, how many limbs hang from it: the end sites of its subtree grouped, one
@@ -259,23 +267,6 @@ class Skeleton:
                            + ends, default=0.0)
             limbs[j] = 1 if reach[j] <= near else sum(limbs[c] for c in kids) + len(ends)
         return limbs
-
-    def trunk_bones(self) -> np.ndarray:
-        """Boolean (J, most tips) per joint and tip (its children, then its end sites, as
-        ``default_blobs`` counts them): the trunk's bones, those of a joint three or more
-        limbs hang from (``limbs_below``), and the short ones (under ``GIRDLE_LENGTH`` of
-        the height) from such a joint to a limb: a pelvis's or shoulder girdle's half, the
-        neck's base."""
-        H, limbs = self.height(), self.limbs_below()
-        tips = [[self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
-                for j in range(self.n_joints)]
-        out = np.zeros((self.n_joints, max(map(len, tips), default=0)), bool)
-        for j, ds in enumerate(tips):
-            p = self.parents[j]
-            for k, d in enumerate(ds):
-                out[j, k] = limbs[j] >= 3 or (p >= 0 and limbs[p] >= 3
-                                              and np.linalg.norm(d) < GIRDLE_LENGTH * H)
-        return out
 
 
 def bone_blob(joint: int, name: str, head: np.ndarray, direction: np.ndarray, r) -> Ellipsoid:

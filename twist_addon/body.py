@@ -1,4 +1,5 @@
-"""The volumetric body: one ellipsoid mesh per blob, parented to its bone, so the tracked
+"""The body's blobs: sized from the bones' lengths (the envelope radii they are read from),
+and the volumetric body, one ellipsoid mesh per blob parented to its bone, so the tracked
 motion shows as a body in the viewport and in renders (the paper's animated Muybridge); and,
 on request, a stick figure: a thin rod along every bone of a blob."""
 
@@ -10,7 +11,7 @@ from mathutils import Matrix
 
 from ..core.se3 import frame_along
 from .armature_action import ArmatureAction
-from .bridge import BridgeError, pose_from_armature, skeleton_from_armature
+from .bridge import BridgeError, pose_from_armature, size_blobs, skeleton_from_armature
 
 SIDE_COLOURS = {"Left": (0.75, 0.25, 0.2, 1.0), "Right": (0.2, 0.35, 0.75, 1.0),
                 None: (0.8, 0.75, 0.65, 1.0)}
@@ -112,4 +113,17 @@ class TWIST_OT_add_volumetric_body(ArmatureAction, bpy.types.Operator):
         return f"added {len(made)} parts riding on '{arm.name}'"
 
 
-CLASSES = (TWIST_OT_add_volumetric_body,)
+class TWIST_OT_size_blobs(ArmatureAction, bpy.types.Operator):
+    """Size every bone's blob (its envelope radii) from its length, as a body's proportions
+    have it: limbs a sixth of their length across, the trunk's bones an adult trunk's width"""
+
+    bl_idname = "twist.size_blobs"
+    bl_label = "Size Blobs"
+
+    def run(self, context) -> str:
+        arm = context.scene.twist.armature
+        n = size_blobs(arm)
+        return f"sized the blobs of '{arm.name}': {n} of {len(arm.data.bones)} bones have one"
+
+
+CLASSES = (TWIST_OT_add_volumetric_body, TWIST_OT_size_blobs)

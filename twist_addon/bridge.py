@@ -23,7 +23,7 @@ from ..core import se3
 from ..core.camera import Camera, Pinhole, View
 from ..core.errors import InputError
 from ..core.pose import CALIBRATED
-from ..core.skeleton import BALL, FIXED, HINGE, Skeleton, bone_blob
+from ..core.skeleton import BALL, FIXED, HINGE, MIN_LENGTH, Skeleton, bone_blob
 
 
 class BridgeError(InputError):
@@ -90,6 +90,25 @@ def skeleton_from_armature(arm) -> Skeleton:
                 if np.linalg.norm(tails[j] - heads[j]) > 1e-6
                 and b.head_radius + b.tail_radius > 0]
     return sk
+
+
+def size_blobs(arm) -> int:
+    """Set every bone's envelope radii to the default blob's short radius for its length
+    (``Skeleton.blob_radii``: a body's proportions, the trunk's bones an adult trunk's
+    width), zero (no blob) for a bone too short to see; returns how many bones have a blob.
+    An imported armature's envelopes are Blender's defaults, the same for a forearm as for
+    the chest."""
+    sk = skeleton_from_armature(arm)
+    W = _matrix(arm.matrix_world)
+    bones = list(arm.data.bones)
+    tips = [(W @ np.append(np.array(b.tail_local), 1))[:3] - sk.rest_positions[j]
+            for j, b in enumerate(bones)]
+    _, s = _object_rotation_and_scale(arm)
+    seen = [np.linalg.norm(d) >= MIN_LENGTH * sk.height() for d in tips]
+    radii = sk.blob_radii(list(enumerate(tips)))
+    for b, r, ok in zip(bones, radii, seen):
+        b.head_radius = b.tail_radius = r / s if ok else 0.0
+    return int(sum(seen))
 
 
 def tracked_skeleton(arm) -> Skeleton:

@@ -63,3 +63,33 @@ def test_stick_figure_rods_run_from_head_to_tail_of_their_bones(bpy_module, regi
                 want = (W @ np.append(np.array(point), 1))[:3]
                 np.testing.assert_allclose((M @ [0, 0, end, 1])[:3], want, atol=1e-5)
             assert np.linalg.norm(M[:3, 0]) < 0.5 * np.linalg.norm(M[:3, 2])  # thin
+
+
+def test_size_blobs_gives_an_imported_armature_a_body_s_proportions(bpy_module, registered,
+                                                                    cmu_walk):
+    bpy = bpy_module
+    bpy.ops.import_anim.bvh(filepath=str(cmu_walk), axis_forward="Y", axis_up="Z")
+    arm = bpy.context.view_layer.objects.active
+    arm.scale = (0.5,) * 3  # envelope radii are the bone's own, before the object's scale
+    bpy.context.view_layer.update()
+    bpy.context.scene.twist.armature = arm
+    bridge = registered.twist_addon.bridge
+
+    def radii():
+        sk = bridge.skeleton_from_armature(arm)
+        return sk, {sk.names[b.joint]: b.radii for b in sk.blobs}
+
+    sk, before = radii()
+    # Blender's importer gives every bone the same envelope: the forearm as thick as the chest
+    assert before["LeftElbow"][1] == pytest.approx(before["Chest"][1])
+    assert bpy.ops.twist.size_blobs() == {"FINISHED"}
+    sk, after = radii()
+    H = sk.height()
+    for name in ("lowerback", "Chest", "LHipJoint", "RHipJoint"):
+        assert np.all(after[name][1:] >= 0.065 * H - 1e-6), name
+    for name in ("LeftElbow", "RightKnee", "LeftShoulder"):
+        L = 2 * after[name][0]  # the blob spans the bone
+        np.testing.assert_allclose(after[name][1:], max(0.16 * L, 0.022 * H), rtol=1e-5)
+    lengths = {b.name: 0.5 * b.length for b in arm.data.bones}
+    assert set(after) == {n for n, L in lengths.items() if L >= 0.03 * H}
+    assert after["Chest"][1] > 2 * after["LeftElbow"][1]
