@@ -115,7 +115,7 @@ class TWIST_OT_add_volumetric_body(ArmatureAction, bpy.types.Operator):
 
 class TWIST_OT_size_blobs(ArmatureAction, bpy.types.Operator):
     """Size every bone's blob (its envelope radii) from its length, as a body's proportions
-    have it: limbs a sixth of their length across, the trunk's bones an adult trunk's width"""
+    have it: a limb's radius a sixth of its length, the trunk's bones an adult trunk's"""
 
     bl_idname = "twist.size_blobs"
     bl_label = "Size Blobs"
