@@ -225,13 +225,12 @@ class Skeleton:
         half the bone, short radii ``blob_radii``'s; bones shorter than ``MIN_LENGTH`` of
         the height get none."""
         H = self.height()
-        bones = [(j, k, d) for j in range(self.n_joints)
-                 for k, d in enumerate([self.offsets[c] for c in self.children(j)]
-                                       + list(self.end_sites[j]))
+        tips = [[self.offsets[c] for c in self.children(j)] + list(self.end_sites[j])
+                for j in range(self.n_joints)]
+        bones = [(j, k, d) for j, ds in enumerate(tips) for k, d in enumerate(ds)
                  if np.linalg.norm(d) >= MIN_LENGTH * H]
         radii = self.blob_radii([(j, d) for j, _, d in bones])
-        n_tips = [len(self.children(j)) + len(self.end_sites[j]) for j in range(self.n_joints)]
-        return [bone_blob(j, self.names[j] if n_tips[j] == 1 else f"{self.names[j]}.{k}",
+        return [bone_blob(j, self.names[j] if len(tips[j]) == 1 else f"{self.names[j]}.{k}",
                           self.rest_positions[j], d, r)
                 for (j, k, d), r in zip(bones, radii)]
 

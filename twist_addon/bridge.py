@@ -49,6 +49,14 @@ def bone_frames(arm) -> np.ndarray:
     return np.array([R_obj @ _matrix(b.matrix_local)[:3, :3] for b in arm.data.bones])
 
 
+def rest_heads_and_tails(arm) -> tuple[np.ndarray, np.ndarray]:
+    """World positions (J, 3) of every bone's head and tail at rest, in bone order."""
+    W = _matrix(arm.matrix_world)
+    bones = arm.data.bones
+    return tuple(np.array([(W @ np.append(np.array(getattr(b, end)), 1))[:3] for b in bones])
+                 for end in ("head_local", "tail_local"))
+
+
 def skeleton_from_armature(arm) -> Skeleton:
     """The armature's rest pose as a core skeleton: one joint per bone, in bone order."""
     bones = list(arm.data.bones)
@@ -59,9 +67,7 @@ def skeleton_from_armature(arm) -> Skeleton:
     if len(roots) != 1:
         raise BridgeError(f"the armature '{arm.name}' has {len(roots)} root bones "
                           f"({', '.join(roots)}); parent them under one root bone")
-    W = _matrix(arm.matrix_world)
-    heads = np.array([(W @ np.append(np.array(b.head_local), 1))[:3] for b in bones])
-    tails = np.array([(W @ np.append(np.array(b.tail_local), 1))[:3] for b in bones])
+    heads, tails = rest_heads_and_tails(arm)
     parents = [names.index(b.parent.name) if b.parent else -1 for b in bones]
     offsets = np.array([heads[j] - (heads[p] if p >= 0 else 0) for j, p in enumerate(parents)])
     C = bone_frames(arm)
@@ -99,14 +105,12 @@ def size_blobs(arm) -> int:
     An imported armature's envelopes are Blender's defaults, the same for a forearm as for
     the chest."""
     sk = skeleton_from_armature(arm)
-    W = _matrix(arm.matrix_world)
-    bones = list(arm.data.bones)
-    tips = [(W @ np.append(np.array(b.tail_local), 1))[:3] - sk.rest_positions[j]
-            for j, b in enumerate(bones)]
+    heads, tails = rest_heads_and_tails(arm)
+    tips = tails - heads
     _, s = _object_rotation_and_scale(arm)
-    seen = [np.linalg.norm(d) >= MIN_LENGTH * sk.height() for d in tips]
+    seen = np.linalg.norm(tips, axis=1) >= MIN_LENGTH * sk.height()
     radii = sk.blob_radii(list(enumerate(tips)))
-    for b, r, ok in zip(bones, radii, seen):
+    for b, r, ok in zip(arm.data.bones, radii, seen):
         b.head_radius = b.tail_radius = r / s if ok else 0.0
     return int(sum(seen))
 

@@ -17,7 +17,7 @@ import numpy as np
 from mathutils import Matrix
 
 from .armature_action import ArmatureAction
-from .bridge import BridgeError
+from .bridge import BridgeError, rest_heads_and_tails
 
 _PRESET_ITEMS = [("CMU", "CMU / BVH", "Bone names of the CMU motion capture BVH files"),
                  ("RIGIFY", "Rigify", "Blender's Rigify human metarig"),
@@ -60,11 +60,9 @@ def _rot(m) -> np.ndarray:
 
 def _leg_length(arm) -> float:
     """The rest pose's root height above its lowest bone end (world units, world z up)."""
-    W = np.array(arm.matrix_world)
-    ends = np.array([(W @ np.append(np.array(p), 1))[:3]
-                     for b in arm.data.bones for p in (b.head_local, b.tail_local)])
-    root = next(b for b in arm.data.bones if b.parent is None)
-    height = (W @ np.append(np.array(root.head_local), 1))[2] - ends[:, 2].min()
+    heads, tails = rest_heads_and_tails(arm)
+    root = next(j for j, b in enumerate(arm.data.bones) if b.parent is None)
+    height = heads[root, 2] - min(heads[:, 2].min(), tails[:, 2].min())
     if height < 1e-6:
         raise BridgeError(f"the root of '{arm.name}' is its lowest point at rest: its legs "
                           "cannot be measured to scale the travel")
