@@ -143,7 +143,27 @@ class _Samples:
     inside: np.ndarray  # (views,) fraction of each view's points inside its image
     sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
-    shape_parts: list = field(default_factory=list)  # per view: (joints, world, target px)
+    shape_parts: list = field(default_factory=list)  # per view: its _ShapePull, or None
+
+
+@dataclass
+class _ShapePull:
+    """One view's silhouette mismatch at a sampled pose, its rows made when asked for (a
+    pose that is only costed needs none): ``mm`` on the crop of the label map ``grid``
+    whose top-left map pixel is ``at``, ``full`` full-resolution pixels per map pixel."""
+
+    mm: sil.Mismatch
+    grid: raycast.LabelGrid
+    at: tuple[int, int]
+    full: int
+
+    def rows(self, every: int) -> tuple[np.ndarray, ...]:
+        """Every ``every``-th pair's blob (N,), the world point under its covered pixel
+        (N, 3), its target in full-resolution pixels (N, 2) and its weight (N,)."""
+        model = self.mm.model[::every] + self.at
+        target = (self.mm.target[::every] + self.at) * self.full
+        hits = self.grid.hits_on_full(model[:, 1].astype(int), model[:, 0].astype(int))
+        return hits.label, hits.world, target, self.mm.weight[::every]
 
 
 
@@ -505,7 +525,7 @@ class FrameFit:
         if fgs is not None:
             for c, ((lab, grid), view_fg) in enumerate(zip(maps, fgs)):
                 if view_fg is None:
-                    shape_parts.append(((), (), (), ()))
+                    shape_parts.append(None)
                     continue
                 fg, (x0, y0), nearest_fg = view_fg
                 crop = (slice(y0, y0 + fg.shape[0]), slice(x0, x0 + fg.shape[1]))
@@ -513,12 +533,7 @@ class FrameFit:
                 mm = sil.mismatch(lab[crop], fg, self.scales.cap(c) / full,
                                   nearest_fg=nearest_fg)
                 shape_cost += s.silhouette * mm.cost
-                mm.model += (x0, y0)
-                mm.target += (x0, y0)
-                hits = grid.hits_on_full(mm.model[:, 1].astype(int),
-                                         mm.model[:, 0].astype(int))
-                shape_parts.append((self._blobs.joint[hits.label], hits.world,
-                                    mm.target * full, mm.weight))
+                shape_parts.append(_ShapePull(mm, grid, (x0, y0), full))
         measured = []
         for k, ps in enumerate(sets):
             world = kin.world_points(ps.seg_joint, ps.ref)
@@ -561,14 +576,14 @@ class FrameFit:
                 pieces[ps.view].append((ps.seg_joint[ok], world, grad, r,
                                         self._pixel_weights(ps, ok, r, sigma)))
         s = self.settings
-        for c, (joints, world, target, pair_w) in enumerate(smp.shape_parts):
-            if not len(joints):
+        for c, pull in enumerate(smp.shape_parts):
+            if pull is None or not len(pull.mm.weight):
                 continue
             lv = self.scales.view_level(c, level)
             g = 2**lv * self.scales.grid(c, lv)  # full-resolution pixels per map pixel
-            every = -(-len(joints) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
-            joints, world, target = joints[::every], world[::every], target[::every]
-            pair_w = pair_w[::every]
+            every = -(-len(pull.mm.weight) // SIL_MAX_ROWS)  # thinned evenly, weights scaled up
+            blob, world, target, pair_w = pull.rows(every)
+            joints = self._blobs.joint[blob]
             n = len(world)
             unit = np.zeros((2 * n, 2))  # x rows, then y rows
             unit[:n, 0] = unit[n:, 1] = 1.0

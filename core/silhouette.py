@@ -23,7 +23,7 @@ import os
 from collections import deque
 from collections.abc import Iterable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from functools import cached_property
 
 import cv2
 import numpy as np
@@ -276,14 +276,44 @@ class LevelMaps:
         return self._maps[level]
 
 
-@dataclass
 class Mismatch:
-    """Where a label map and a foreground disagree, in level pixels (x, y)."""
+    """Where a label map and a foreground disagree, in level pixels (x, y): the cost, made at
+    once, and the pairs that pull, made when first asked for (most poses are only costed)."""
 
-    model: np.ndarray  # (N, 2) covered pixels to move
-    target: np.ndarray  # (N, 2) where each should go (its match, less the slack)
-    cost: float  # sum of capped squared distances, weighted
-    weight: np.ndarray  # (N,) each pair's weight
+    def __init__(self, cost: float, slack: float, terms: list[tuple] = ()):
+        """``terms``: per chamfer term, its pulling pairs as the pixels' rows and columns
+        here and of their matches (four (N,) arrays), their distances (N,), whether the
+        match is the covered pixel, and the term's weight."""
+        self.cost = cost  # sum of capped squared distances, weighted
+        self._slack = slack
+        self._terms = list(terms)
+
+    @cached_property
+    def _pairs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        model, target, weight = [np.zeros((0, 2))], [np.zeros((0, 2))], [np.zeros(0)]
+        for ys, xs, iy, ix, dist, move_near, w in self._terms:
+            near = np.stack([ix, iy], 1).astype(float)
+            here = np.stack([xs, ys], 1).astype(float)
+            m, t = (near, here) if move_near else (here, near)
+            model.append(m)
+            target.append(m + (t - m) * (1 - self._slack / dist)[:, None])
+            weight.append(np.full(len(m), w))
+        return np.concatenate(model), np.concatenate(target), np.concatenate(weight)
+
+    @property
+    def model(self) -> np.ndarray:
+        """(N, 2) covered pixels to move."""
+        return self._pairs[0]
+
+    @property
+    def target(self) -> np.ndarray:
+        """(N, 2) where each should go (its match, less the slack)."""
+        return self._pairs[1]
+
+    @property
+    def weight(self) -> np.ndarray:
+        """(N,) each pair's weight."""
+        return self._pairs[2]
 
 
 def distance_to_body(fg: np.ndarray) -> np.ndarray:
@@ -330,7 +360,7 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
     cost = 0.0
     # uncovered foreground pulls its nearest covered pixel; covered background is pulled to
     # its nearest foreground pixel
-    model, target, weight = [], [], []
+    terms = []
     nearest_fg = NearestPixel(fg) if nearest_fg is None else nearest_fg
     for src, nearest, move_near, w in ((fg & ~covered, NearestPixel(covered), True,
                                         uncovered_weight),
@@ -342,16 +372,8 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
         dist = np.hypot(iy - ys, ix - xs)
         cost += w * float(np.sum(np.maximum(np.minimum(dist, cap) - slack, 0) ** 2))
         keep = (dist <= cap) & (dist > slack)
-        near = np.stack([ix[keep], iy[keep]], 1).astype(float)
-        here = np.stack([xs[keep], ys[keep]], 1).astype(float)
-        m, t = (near, here) if move_near else (here, near)
-        model.append(m)
-        target.append(m + (t - m) * (1 - slack / dist[keep])[:, None])
-        weight.append(np.full(len(m), w))
-    if not model:
-        return Mismatch(np.zeros((0, 2)), np.zeros((0, 2)), cost, np.zeros(0))
-    return Mismatch(np.concatenate(model), np.concatenate(target), cost,
-                    np.concatenate(weight))
+        terms.append((ys[keep], xs[keep], iy[keep], ix[keep], dist[keep], move_near, w))
+    return Mismatch(cost, slack, terms)
 
 
 class SilhouetteCue:
