@@ -18,15 +18,10 @@ _SMALL = 1e-8
 def hat3(w: np.ndarray) -> np.ndarray:
     """Skew matrix [w]x with [w]x @ p == cross(w, p); w has shape (..., 3) -> (..., 3, 3)."""
     w = np.asarray(w, dtype=float)
-    z = np.zeros(w.shape[:-1])
-    return np.stack(
-        [
-            np.stack([z, -w[..., 2], w[..., 1]], -1),
-            np.stack([w[..., 2], z, -w[..., 0]], -1),
-            np.stack([-w[..., 1], w[..., 0], z], -1),
-        ],
-        -2,
-    )
+    W = np.zeros(w.shape[:-1] + (3, 3))
+    W[..., 0, 1], W[..., 0, 2], W[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    W[..., 1, 0], W[..., 2, 0], W[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    return W
 
 
 def vee3(W: np.ndarray) -> np.ndarray:
@@ -50,13 +45,22 @@ def vee6(X: np.ndarray) -> np.ndarray:
     return np.concatenate([X[:3, 3], vee3(X[:3, :3])])
 
 
-def _sinc_terms(theta: np.ndarray):
-    """A = sin t / t, B = (1 - cos t) / t^2, C = (t - sin t) / t^3, series near 0."""
+def _sinc_ab(theta: np.ndarray):
+    """A = sin t / t and B = (1 - cos t) / t^2, series near 0."""
     t2 = theta * theta
     small = theta < 1e-4
     ts = np.where(small, 1.0, theta)
     A = np.where(small, 1 - t2 / 6 + t2 * t2 / 120, np.sin(ts) / ts)
     B = np.where(small, 0.5 - t2 / 24 + t2 * t2 / 720, (1 - np.cos(ts)) / ts**2)
+    return A, B
+
+
+def _sinc_terms(theta: np.ndarray):
+    """``_sinc_ab``'s A and B, and C = (t - sin t) / t^3, series near 0."""
+    A, B = _sinc_ab(theta)
+    t2 = theta * theta
+    small = theta < 1e-4
+    ts = np.where(small, 1.0, theta)
     C = np.where(small, 1 / 6 - t2 / 120 + t2 * t2 / 5040, (ts - np.sin(ts)) / ts**3)
     return A, B, C
 
@@ -70,7 +74,7 @@ def exp_so3(w: np.ndarray) -> np.ndarray:
     if w.shape == (3,):  # the common case, without array overhead
         return _exp_so3_one(float(w[0]), float(w[1]), float(w[2]))
     theta = np.linalg.norm(w, axis=-1)
-    A, B, _ = _sinc_terms(theta)
+    A, B = _sinc_ab(theta)
     W = hat3(w)
     eye = np.broadcast_to(np.eye(3), W.shape)
     return eye + A[..., None, None] * W + B[..., None, None] * (W @ W)
@@ -130,7 +134,7 @@ def log_se3(G: np.ndarray) -> np.ndarray:
     w = log_so3(G[:3, :3])
     theta = np.linalg.norm(w)
     W = hat3(w)
-    A, B, _ = _sinc_terms(np.asarray(theta))
+    A, B = _sinc_ab(np.asarray(theta))
     if theta < 1e-4:
         coef = 1 / 12 + theta * theta / 720
     else:

@@ -62,7 +62,7 @@ def outlines(view: Camera, A: np.ndarray, C: np.ndarray):
     """Each ellipsoid's outline as row spans: centres c (..., 2), row range (..., 2) and the
     forms P (..., 2, 2) of ``Camera.ellipses``."""
     c, P = view.ellipses(A, C)
-    det = np.linalg.det(P)
+    det = P[..., 0, 0] * P[..., 1, 1] - P[..., 0, 1] * P[..., 1, 0]
     half = np.sqrt(np.stack([P[..., 1, 1], P[..., 0, 0]], -1) / det[..., None])
     return c, half, P
 
@@ -118,8 +118,9 @@ def span_sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
     rows = np.arange(S.shape[0])
     total = np.sum(S[rows, hi] - S[rows, lo], axis=(1, 2))
     for i, k in itertools.combinations(range(lo.shape[1]), 2):
-        a, b = np.maximum(lo[:, i], lo[:, k]), np.minimum(hi[:, i], hi[:, k])
-        total -= np.sum(np.where(b > a, S[rows, np.maximum(a, b)] - S[rows, a], 0), axis=1)
+        a = np.maximum(lo[:, i], lo[:, k])  # the overlap's span, empty where b <= a
+        b = np.maximum(np.minimum(hi[:, i], hi[:, k]), a)
+        total -= np.sum(S[rows, b] - S[rows, a], axis=1)
     return total
 
 
