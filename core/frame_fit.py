@@ -67,6 +67,10 @@ SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equat
 # level pixels from any pixel that may be the body past which a lost limb's pixel of the
 # frame before is taken for backdrop (``release_lost_limbs``)
 LOST_REACH = 1.5
+# views whose outlines, all bearing a limb's turn out, keep it without its pixels' word
+# (``_outlines_bear_out``): two views' silhouettes fitted a wrong turn on a busy or noisy
+# backdrop, or in hard sunlight, about as often as the right one on a plain backdrop
+OUTLINE_VIEWS = 3
 
 
 @dataclass(kw_only=True)
@@ -295,12 +299,8 @@ class FrameFit:
         point of their bones where the body cannot be now (``Limbs.bone_off_body``), and
         none one there once turned. A still backdrop's pixel is a plain negative: the body
         is not there. A joint several limbs hang from (the trunk's) is not a limb's."""
-        if not backdrops:
-            return None
-        moved = self.skeleton.moved_by()
-        chain = [lb for lb in self._search.limbs if moved[lb.joint, limb.joint]]
-        if not all(moved[a.joint, b.joint] or moved[b.joint, a.joint]
-                   for a in chain for b in chain):
+        chain = self._chain(limb)
+        if not backdrops or chain is None:
             return None
         turned = est.copy()
         for lb in chain:
@@ -312,6 +312,38 @@ class FrameFit:
         have = np.all(~np.isnan(now) & ~np.isnan(then), axis=0)
         if have.sum() >= 2 and np.all(then[:, have] == 0) and np.any(now[:, have] > 0):
             return turned, [d for lb in chain for d in lb.dofs]
+        return None
+
+    def _chain(self, limb) -> list | None:
+        """The search's limbs that ``limb``'s joint moves, itself first, where they hang in
+        one line; None where they branch (the trunk's joints, several limbs hang from)."""
+        moved = self.skeleton.moved_by()
+        chain = [lb for lb in self._search.limbs if moved[lb.joint, limb.joint]]
+        if all(moved[a.joint, b.joint] or moved[b.joint, a.joint] for a in chain for b in chain):
+            return chain
+        return None
+
+    def _outlines_bear_out(self, est: BodyPose, searched: BodyPose, limb, searched_on: tuple
+                           ) -> BodyPose | None:
+        """``est`` with ``limb`` turned as in ``searched`` where the outlines of at least
+        ``OUTLINE_VIEWS`` views see the limb and every view that sees it scores the turn
+        better than the search's margin (``LimbSearch.view_costs``); else None. A view sees
+        the limb where its score at either pose is larger than the margin: the pixels the
+        rest of the body leaves free score, those under it or unsure do not, and a limb
+        that lies on them both ways is not seen there. ``searched_on``: the search's views
+        and foreground maps (``_search_limbs``). Not for a joint several limbs hang from: its
+        own segment's outline is scored with the limbs below it taken out, and would turn
+        onto their silhouettes."""
+        if not searched_on or self._chain(limb) is None:
+            return None
+        turned = est.copy()
+        for j, _, _ in limb.dofs:
+            turned.rotations[j] = searched.rotations[j]
+        cost, area = self._search.view_costs(limb, [est, turned], *searched_on)
+        margin = self.settings.limb_search * area
+        sees = ~np.isnan(area) & (np.abs(cost).max(axis=0) > margin)
+        if sees.sum() >= OUTLINE_VIEWS and np.all(cost[0, sees] - cost[1, sees] > margin[sees]):
+            return turned
         return None
 
     def _pixels_bear_out(self, base: _Samples, cand: BodyPose, limb, sets: list[PointSet],
@@ -348,7 +380,11 @@ class FrameFit:
         (``FrameResult.searched``); ``searched_on``: the views the search read on tracker
         level ``level`` and their foreground maps (``_search_limbs``').
         Parents first, a limb's turn is kept when the backdrops refute the limb where it is
-        and bear it out turned, with the limbs below it (``_refuted_chain``), or when, in
+        and bear it out turned, with the limbs below it (``_refuted_chain``), when the
+        outlines of three or more views see the limb and every one of them scores the turn
+        better (``_outlines_bear_out``: a wrong turn seldom fits three silhouettes seen from
+        apart, where the limb's pixels of the earlier frames may be what it wrongly covered
+        and hold it there), or when, in
         every view that sees the limb, its pixels of the earlier frames match the new image
         clearly better turned than not (``_clearly_lower``); else the limb keeps its
         predicted motion. The silhouette proposes, brightness decides: an outline alone also
@@ -374,8 +410,12 @@ class FrameFit:
             if self.skeleton.names[limb.joint] not in turned:
                 continue
             refuted = self._refuted_chain(out, searched, limb, backdrops)
+            outlined = None if refuted is not None else \
+                self._outlines_bear_out(out, searched, limb, searched_on)
             if refuted is not None:
                 out, dofs = refuted
+            elif outlined is not None:
+                out, dofs = outlined, limb.dofs
             else:
                 cand = out.copy()
                 for j, _, _ in limb.dofs:

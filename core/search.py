@@ -124,6 +124,13 @@ def span_sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
     return total
 
 
+def _area(lo: np.ndarray, hi: np.ndarray, shape) -> float:
+    """Pixels in one candidate's outline (spans (1, B, rows) in a box whose prefix sums have
+    ``shape``): the sum of a ramp's increments."""
+    ramp = np.broadcast_to(np.arange(shape[1], dtype=float), shape)
+    return float(span_sums(lo, hi, ramp)[0])
+
+
 class LimbSearch:
     """Searches the limbs of ``skeleton`` against per-view foregrounds on one level."""
 
@@ -222,6 +229,32 @@ class LimbSearch:
         np.cumsum(gain, axis=1, out=S[:, 1:])
         return S
 
+    def view_costs(self, limb: _Limb, poses: Sequence[BodyPose], views: Sequence[Camera],
+                   fgs: Sequence[np.ndarray | None]) -> tuple[np.ndarray, np.ndarray]:
+        """What the search scores ``limb`` by, per view: its own segment's outline at each
+        of ``poses`` (P) against the rest of the body at the first, (P, V), and the outline's
+        area (pixels) at the first, (V,); NaN for a view without a foreground map (None in
+        ``fgs``) or where the outlines leave the image."""
+        frames = [blob_frames(self.blobs, Kinematics(self.sk, p).segments) for p in poses]
+        A, C = frames[0]
+        rest = np.setdiff1d(np.arange(len(self.blobs)), limb.below)
+        Ak = np.stack([Ap[limb.own] for Ap, _ in frames])
+        Ck = np.stack([Cp[limb.own] for _, Cp in frames])
+        cost = np.full((len(poses), len(views)), np.nan)
+        area = np.full(len(views), np.nan)
+        for v, (view, fg) in enumerate(zip(views, fgs)):
+            if fg is None:
+                continue
+            c, half, P = outlines(view, Ak, Ck)
+            box = _box(c, half, fg.shape)
+            if box is None:
+                continue
+            S = self._gain_sums(view, fg, A[rest], C[rest], box)
+            lo, hi = spans(c, half, P, box)
+            cost[:, v] = span_sums(lo, hi, S)
+            area[v] = _area(lo[:1], hi[:1], S.shape)
+        return cost, area
+
     def _allowed(self, limb: _Limb, pose: BodyPose, cands: np.ndarray) -> np.ndarray:
         """Which candidates keep every limited hinge within its range (or no farther out of
         it than it is); the current pose, all zeros, always."""
@@ -267,9 +300,8 @@ class LimbSearch:
                 box, S = sums[v]
                 lo, hi = spans(c, half, P, box)
                 cost += span_sums(lo, hi, S)
-                if stage == 0:  # the current pose's outline: the sum of a ramp's increments
-                    ramp = np.broadcast_to(np.arange(S.shape[1], dtype=float), S.shape)
-                    area += float(span_sums(lo[:1], hi[:1], ramp)[0])
+                if stage == 0:
+                    area += _area(lo[:1], hi[:1], S.shape)
             if stage == 0:
                 current = cost[0]
             cost += self.margin * area * np.sum((cands / TURN_SCALE) ** 2, axis=1)

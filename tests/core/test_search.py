@@ -181,3 +181,34 @@ def test_unsure_pixels_weigh_nothing_in_the_search():
     assert LimbSearch._foreground_share(view, fg, A, C) == 1.0
     fg[body & (fg == FOREGROUND)] = BACKDROP
     assert LimbSearch._foreground_share(view, fg, A, C) == 0.0
+
+
+def test_a_limbs_outline_is_scored_per_view_against_the_rest_of_the_body_at_the_first_pose():
+    """``view_costs`` against painting: per pose and view, the sum of the cover costs
+    (1 backdrop, -UNCOVERED_GAIN foreground, 0 unsure) over the limb's own blobs' outline,
+    with the pixels the rest of the body covers at the first pose costing nothing; the area
+    is the outline's pixel count at the first pose; a view without a map is NaN."""
+    sk = human_template()
+    search = LimbSearch(sk, 0.1)
+    limb = next(lb for lb in search.limbs if sk.names[lb.joint] == "RightShoulder")
+    first = _rest(sk)
+    second = _turned(sk, first, {"RightShoulder": [0, 0, -50]})  # swung out from the trunk
+    fg = np.random.default_rng(2).choice([BACKDROP, FOREGROUND, UNSURE], BODY,
+                                         p=[0.4, 0.5, 0.1]).astype(np.uint8)
+    cost, area = search.view_costs(limb, [first, second], first.views, [None, fg])
+    assert np.isnan(cost[:, 0]).all() and np.isnan(area[0])
+    view, box = first.views[1], (0, 0, BODY[1], BODY[0])
+    A0, C0 = raycast.blob_frames(search.blobs, Kinematics(sk, first).segments)
+    rest = np.zeros(BODY, bool)
+    others = np.setdiff1d(np.arange(len(search.blobs)), limb.below)
+    paint(rest, view, A0[others], C0[others], box)
+    price = np.where(fg == BACKDROP, 1.0, np.where(fg == FOREGROUND, -UNCOVERED_GAIN, 0.0))
+    price[rest] = 0.0
+    for k, pose in enumerate((first, second)):
+        A, C = raycast.blob_frames(search.blobs, Kinematics(sk, pose).segments)
+        own = np.zeros(BODY, bool)
+        paint(own, view, A[limb.own], C[limb.own], box)
+        assert (own & ~rest).sum() > 100
+        np.testing.assert_allclose(cost[k, 1], price[own].sum(), atol=1e-9)
+        if k == 0:
+            assert area[1] == own.sum()

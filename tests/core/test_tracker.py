@@ -3,13 +3,15 @@
 import numpy as np
 import pytest
 
-from core import blas, se3
+from core import blas, raycast, se3
+from core import silhouette as sil
 from core.camera import View
 from core.errors import InputError
 from core.frame_fit import PointSet
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
+from core.search import paint
 from core.settings import TrackerSettings
 from core.side_on import BODY, TURNED, depth_blind_joints, side_on_skeleton, turned_from
 from core.skeleton import HINGE, human_template
@@ -658,6 +660,30 @@ def test_a_lost_limb_the_backdrop_refutes_in_a_view_is_turned_back_without_brigh
     res = tracker.track_frame(lost, 1, pose, 0, lost, 2)
     assert _limb_errors(sk, res.pose, pose).max() < 2.0
     assert joint in res.searched
+
+
+def test_outlines_alone_turn_a_limb_only_where_three_views_see_it_and_all_bear_it_out(body):
+    """The evidence rule for a turn whose pixels say nothing (a lost limb's pixels are what
+    it wrongly covered): the arm, held out forward and to the side, seen in all three views
+    against a clean silhouette, is turned 45 degrees back onto it. Two views that agree are
+    not enough, nor three where one view's silhouette lacks the arm."""
+    sk, rest = body
+    truth = _swung(sk, _swung(sk, rest, "RightShoulder", -60, 1), "RightShoulder", -50, 2)
+    lost = _swung(sk, truth, "RightShoulder", 45, 1)
+    tracker = Tracker(sk, [[render(sk, truth, c)] for c in range(3)], CALIBRATED)
+    limb = next(lb for lb in tracker._search.limbs if sk.names[lb.joint] == "RightShoulder")
+    fgs = [np.where(render(sk, truth, c) != render(sk, truth, c)[0, 0], sil.FOREGROUND,
+                    sil.BACKDROP).astype(np.uint8) for c in range(3)]
+    turned = tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs))
+    assert turned is not None and _limb_errors(sk, turned, truth).max() < 1e-6
+    assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs[:2] + [None])) is None
+    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, truth).segments)
+    arm = np.zeros(fgs[2].shape, bool)
+    below = [i for i, b in enumerate(sk.blobs) if b.joint in (sk.index("RightShoulder"),
+                                                              sk.index("RightElbow"))]
+    paint(arm, truth.views[2], A[below], C[below], (0, 0, arm.shape[1], arm.shape[0]))
+    without = fgs[:2] + [np.where(arm, sil.BACKDROP, fgs[2]).astype(np.uint8)]
+    assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, without)) is None
 
 
 def test_a_limb_the_search_turned_is_predicted_where_it_was_on_the_next_frame(body):
