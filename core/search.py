@@ -243,17 +243,27 @@ class LimbSearch:
         cost = np.full((len(poses), len(views)), np.nan)
         area = np.full(len(views), np.nan)
         for v, (view, fg) in enumerate(zip(views, fgs)):
-            if fg is None:
-                continue
-            c, half, P = outlines(view, Ak, Ck)
-            box = _box(c, half, fg.shape)
-            if box is None:
-                continue
-            S = self._gain_sums(view, fg, A[rest], C[rest], box)
-            lo, hi = spans(c, half, P, box)
-            cost[:, v] = span_sums(lo, hi, S)
-            area[v] = _area(lo[:1], hi[:1], S.shape)
+            scored = None if fg is None else self._view_cost(view, fg, Ak, Ck, A, C, rest)
+            if scored is not None:
+                cost[:, v], area[v], _ = scored
         return cost, area
+
+    def _view_cost(self, view: Camera, fg: np.ndarray, Ak, Ck, A, C, rest, kept=None
+                   ) -> tuple | None:
+        """Outlines Ak, Ck (K candidates of B blobs each) scored in one view: per candidate
+        the cost of covering ``fg``'s pixels where the blobs ``rest`` of A, C (every blob's
+        ``blob_frames``) do not, the first candidate's area, and the box with its gains'
+        row prefix sums (``_gain_sums``). ``kept``: such a box and sums from an earlier
+        call, reused where the outlines fit in it. None where they leave the image."""
+        c, half, P = outlines(view, Ak, Ck)
+        box = _box(c, half, fg.shape)
+        if box is None:
+            return None
+        if kept is None or not _inside(box, kept[0]):
+            kept = box, self._gain_sums(view, fg, A[rest], C[rest], box)
+        box, S = kept
+        lo, hi = spans(c, half, P, box)
+        return span_sums(lo, hi, S), _area(lo[:1], hi[:1], S.shape), kept
 
     def _allowed(self, limb: _Limb, pose: BodyPose, cands: np.ndarray) -> np.ndarray:
         """Which candidates keep every limited hinge within its range (or no farther out of
@@ -289,19 +299,14 @@ class LimbSearch:
             if stage == 0:
                 area = 0.0
             for v, (view, fg) in enumerate(zip(views, fgs)):
-                if fg is None:
+                scored = None if fg is None else self._view_cost(view, fg, Ak, Ck, A, C, rest,
+                                                                 sums.get(v))
+                if scored is None:
                     continue
-                c, half, P = outlines(view, Ak, Ck)
-                box = _box(c, half, fg.shape)
-                if box is None:
-                    continue
-                if v not in sums or not _inside(box, sums[v][0]):
-                    sums[v] = box, self._gain_sums(view, fg, A[rest], C[rest], box)
-                box, S = sums[v]
-                lo, hi = spans(c, half, P, box)
-                cost += span_sums(lo, hi, S)
+                view_cost, view_area, sums[v] = scored
+                cost += view_cost
                 if stage == 0:
-                    area += _area(lo[:1], hi[:1], S.shape)
+                    area += view_area
             if stage == 0:
                 current = cost[0]
             cost += self.margin * area * np.sum((cands / TURN_SCALE) ** 2, axis=1)
