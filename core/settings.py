@@ -73,8 +73,9 @@ class TrackerSettings:
                                "and by that again per 45 degrees of turn squared, and every "
                                "view whose pixels see the limb bears the turn out, or two or "
                                "more views' backdrops show the limb cannot be where it is and "
-                               "can be where it turned (0: off). Catches limbs faster than a "
-                               "blob's width a frame")
+                               "can be where it turned, or three or more views see its outline "
+                               "and each scores the turn better by this share (0: off). "
+                               "Catches limbs faster than a blob's width a frame")
     release_lost_limbs: bool = _knob(True, "A limb flagged on the frame before leaves out "
                                      "its pixels of that frame that the view's still "
                                      "backdrop shows were backdrop: a limb lost onto a "
