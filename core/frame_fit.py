@@ -397,7 +397,7 @@ class FrameFit:
         pixels show (it was hidden) is not turned by brightness: its outline alone fits a
         shadow, or foreground another limb left uncovered, as well as the limb, and what
         the footage does not show is held."""
-        base = self.sample(est, Kinematics(self.skeleton, est), sets, levels, level)
+        base = None  # ``est``'s look at the point sets, taken when brightness is first asked
         keys = [ps.key_points() for ps in sets]
         backdrops = ()  # the search's views (``searched_on``) with their distance maps
         if searched_on:
@@ -420,6 +420,8 @@ class FrameFit:
                 cand = out.copy()
                 for j, _, _ in limb.dofs:
                     cand.rotations[j] = searched.rotations[j]
+                if base is None:
+                    base = self.sample(est, Kinematics(self.skeleton, est), sets, levels, level)
                 seen = self._pixels_bear_out(base, cand, limb, sets, keys, levels, level)
                 if not seen:
                     continue
