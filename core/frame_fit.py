@@ -384,13 +384,13 @@ class FrameFit:
         outlines of three or more views see the limb and every one of them scores the turn
         better (``_outlines_bear_out``: a wrong turn seldom fits three silhouettes seen from
         apart, where the limb's pixels of the earlier frames may be what it wrongly covered
-        and hold it there), or when, in
-        every view that sees the limb, its pixels of the earlier frames match the new image
-        clearly better turned than not (``_clearly_lower``); else the limb keeps its
-        predicted motion. The silhouette proposes, brightness decides: an outline alone also
-        fits shadows, clutter and the gaps between other limbs. But the pixels of a limb
-        already lost are what it wrongly covered, and they hold it there: where a backdrop
-        shows the limb cannot be where it is, the outlines of every view decide. Where two or
+        and hold it there), or when, in every view that sees the limb, its pixels of the
+        earlier frames match the new image clearly better turned than not
+        (``_clearly_lower``); else the limb keeps its predicted motion. The silhouette
+        proposes, brightness decides: an outline alone also fits shadows, clutter and the
+        gaps between other limbs. But the pixels of a limb already lost are what it wrongly
+        covered, and they hold it there: where a backdrop shows the limb cannot be where it
+        is, or three views' outlines agree, the outlines decide. Where two or
         more views see the limb, a view may bear the turn out by the key frame's pixels
         alone (they are the user's pose); one view's key pixels alone are not enough (a
         limb's shading changes as it turns under a hard light). A limb no view's earlier
