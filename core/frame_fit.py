@@ -171,6 +171,15 @@ class _ShapePull:
 
 
 
+def _with_turns(est: BodyPose, searched: BodyPose, limbs) -> BodyPose:
+    """``est`` with the degrees of freedom of the search's ``limbs`` as ``searched`` has them."""
+    out = est.copy()
+    for limb in limbs:
+        for j, _, _ in limb.dofs:
+            out.rotations[j] = searched.rotations[j]
+    return out
+
+
 def _clearly_lower(new: np.ndarray, old: np.ndarray) -> bool:
     """Whether paired costs ``new`` are clearly lower than ``old``: the mean of their
     differences over twice its standard error."""
@@ -302,10 +311,7 @@ class FrameFit:
         chain = self._chain(limb)
         if not backdrops or chain is None:
             return None
-        turned = est.copy()
-        for lb in chain:
-            for j, _, _ in lb.dofs:
-                turned.rotations[j] = searched.rotations[j]
+        turned = _with_turns(est, searched, chain)
         rows = [self._limbs.names.index(self.skeleton.names[lb.joint]) for lb in chain]
         now, then = (self._limbs.bone_off_body(Kinematics(self.skeleton, p), *backdrops)[rows]
                      for p in (est, turned))
@@ -336,9 +342,7 @@ class FrameFit:
         onto their silhouettes."""
         if not searched_on or self._chain(limb) is None:
             return None
-        turned = est.copy()
-        for j, _, _ in limb.dofs:
-            turned.rotations[j] = searched.rotations[j]
+        turned = _with_turns(est, searched, [limb])
         cost, area = self._search.view_costs(limb, [est, turned], *searched_on)
         margin = self.settings.limb_search * area
         sees = ~np.isnan(area) & (np.abs(cost).max(axis=0) > margin)
@@ -410,16 +414,13 @@ class FrameFit:
             if self.skeleton.names[limb.joint] not in turned:
                 continue
             refuted = self._refuted_chain(out, searched, limb, backdrops)
-            outlined = None if refuted is not None else \
-                self._outlines_bear_out(out, searched, limb, searched_on)
             if refuted is not None:
                 out, dofs = refuted
-            elif outlined is not None:
+            elif (outlined := self._outlines_bear_out(out, searched, limb,
+                                                      searched_on)) is not None:
                 out, dofs = outlined, limb.dofs
             else:
-                cand = out.copy()
-                for j, _, _ in limb.dofs:
-                    cand.rotations[j] = searched.rotations[j]
+                cand = _with_turns(out, searched, [limb])
                 if base is None:
                     base = self.sample(est, Kinematics(self.skeleton, est), sets, levels, level)
                 seen = self._pixels_bear_out(base, cand, limb, sets, keys, levels, level)
