@@ -69,7 +69,8 @@ SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equat
 LOST_REACH = 1.5
 # views whose outlines, all bearing a limb's turn out, keep it without its pixels' word
 # (``_outlines_bear_out``): two views' silhouettes fitted a wrong turn on a busy or noisy
-# backdrop, or in hard sunlight, about as often as the right one on a plain backdrop
+# backdrop, or in hard sunlight, about as often as the right one on a plain backdrop, unless
+# both also showed the limb off the body where it was
 OUTLINE_VIEWS = 3
 
 
@@ -333,7 +334,10 @@ class FrameFit:
                            ) -> BodyPose | None:
         """``est`` with ``limb`` turned as in ``searched`` where the outlines of at least
         ``OUTLINE_VIEWS`` views see the limb and every view that sees it scores the turn
-        better than the search's margin (``LimbSearch.view_costs``); else None. A view sees
+        better than the search's margin (``LimbSearch.view_costs``), or where two or more
+        see it and every one of them finds it off the body now and on the body turned (its
+        score over the margin, then under minus the margin: more of the outline on the
+        backdrop than on the silhouette, then the other way round); else None. A view sees
         the limb where its score at either pose is larger than the margin: the pixels the
         rest of the body leaves free score, those under it or unsure do not, and a limb
         that lies on them both ways is not seen there. ``searched_on``: the search's views
@@ -346,7 +350,10 @@ class FrameFit:
         cost, area = self._search.view_costs(limb, [est, turned], *searched_on)
         margin = self.settings.limb_search * area
         sees = ~np.isnan(area) & (np.abs(cost).max(axis=0) > margin)
-        if sees.sum() >= OUTLINE_VIEWS and np.all(cost[0, sees] - cost[1, sees] > margin[sees]):
+        now, then, m = cost[0, sees], cost[1, sees], margin[sees]
+        if sees.sum() >= OUTLINE_VIEWS and np.all(now - then > m):
+            return turned
+        if sees.sum() >= 2 and np.all(now > m) and np.all(then < -m):
             return turned
         return None
 
@@ -386,15 +393,16 @@ class FrameFit:
         Parents first, a limb's turn is kept when the backdrops refute the limb where it is
         and bear it out turned, with the limbs below it (``_refuted_chain``), when the
         outlines of three or more views see the limb and every one of them scores the turn
-        better (``_outlines_bear_out``: a wrong turn seldom fits three silhouettes seen from
-        apart, where the limb's pixels of the earlier frames may be what it wrongly covered
-        and hold it there), or when, in every view that sees the limb, its pixels of the
-        earlier frames match the new image clearly better turned than not
+        better, or two or more see it off the body and on it turned (``_outlines_bear_out``:
+        a wrong turn seldom fits three silhouettes seen from apart, nor takes a limb off
+        the backdrop in two, where the limb's pixels of the earlier frames may be what it
+        wrongly covered and hold it there), or when, in every view that sees the limb, its
+        pixels of the earlier frames match the new image clearly better turned than not
         (``_clearly_lower``); else the limb keeps its predicted motion. The silhouette
         proposes, brightness decides: an outline alone also fits shadows, clutter and the
         gaps between other limbs. But the pixels of a limb already lost are what it wrongly
         covered, and they hold it there: where a backdrop shows the limb cannot be where it
-        is, or three views' outlines agree, the outlines decide. Where two or
+        is, or the views' outlines agree as above, the outlines decide. Where two or
         more views see the limb, a view may bear the turn out by the key frame's pixels
         alone (they are the user's pose); one view's key pixels alone are not enough (a
         limb's shading changes as it turns under a hard light). A limb no view's earlier

@@ -74,7 +74,8 @@ class TrackerSettings:
                                "view whose pixels see the limb bears the turn out, or two or "
                                "more views' backdrops show the limb cannot be where it is and "
                                "can be where it turned, or three or more views see its outline "
-                               "and each scores the turn better by this share (0: off). "
+                               "and each scores the turn better by this share, or two or more "
+                               "see it off the body and on the body turned (0: off). "
                                "Catches limbs faster than a blob's width a frame")
     release_lost_limbs: bool = _knob(True, "A limb flagged on the frame before leaves out "
                                      "its pixels of that frame that the view's still "

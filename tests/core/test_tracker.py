@@ -662,11 +662,13 @@ def test_a_lost_limb_the_backdrop_refutes_in_a_view_is_turned_back_without_brigh
     assert joint in res.searched
 
 
-def test_outlines_alone_turn_a_limb_only_where_three_views_see_it_and_all_bear_it_out(body):
-    """The evidence rule for a turn whose pixels say nothing (a lost limb's pixels are what
+def test_outlines_alone_turn_a_limb_where_three_views_bear_it_out_or_two_refute_it(body):
+    """The evidence rules for a turn whose pixels say nothing (a lost limb's pixels are what
     it wrongly covered): the arm, held out forward and to the side, seen in all three views
-    against a clean silhouette, is turned 45 degrees back onto it. Two views that agree are
-    not enough, nor three where one view's silhouette lacks the arm."""
+    against a clean silhouette, is turned 45 degrees back onto it. Two views turn it too,
+    where each shows the lost arm over the backdrop and the turned one over the body; not
+    where one of them shows something of the body's where the lost arm lies (a shadow, a
+    limb's twin), nor three views where one view's silhouette lacks the arm."""
     sk, rest = body
     truth = _swung(sk, _swung(sk, rest, "RightShoulder", -60, 1), "RightShoulder", -50, 2)
     lost = _swung(sk, truth, "RightShoulder", 45, 1)
@@ -676,13 +678,21 @@ def test_outlines_alone_turn_a_limb_only_where_three_views_see_it_and_all_bear_i
                     sil.BACKDROP).astype(np.uint8) for c in range(3)]
     turned = tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs))
     assert turned is not None and _limb_errors(sk, turned, truth).max() < 1e-6
-    assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs[:2] + [None])) is None
-    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, truth).segments)
-    arm = np.zeros(fgs[2].shape, bool)
-    below = [i for i, b in enumerate(sk.blobs) if b.joint in (sk.index("RightShoulder"),
-                                                              sk.index("RightElbow"))]
-    paint(arm, truth.views[2], A[below], C[below], (0, 0, arm.shape[1], arm.shape[0]))
-    without = fgs[:2] + [np.where(arm, sil.BACKDROP, fgs[2]).astype(np.uint8)]
+    two = tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs[:2] + [None]))
+    assert two is not None and _limb_errors(sk, two, truth).max() < 1e-6
+
+    def arm_at(pose, view):
+        A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, pose).segments)
+        arm = np.zeros(fgs[view].shape, bool)
+        below = [i for i, b in enumerate(sk.blobs)
+                 if b.joint in (sk.index("RightShoulder"), sk.index("RightElbow"))]
+        paint(arm, pose.views[view], A[below], C[below], (0, 0, arm.shape[1], arm.shape[0]))
+        return arm
+
+    shown = fgs[:1] + [np.where(arm_at(lost, 1), sil.FOREGROUND, fgs[1]).astype(np.uint8),
+                       None]
+    assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, shown)) is None
+    without = fgs[:2] + [np.where(arm_at(truth, 2), sil.BACKDROP, fgs[2]).astype(np.uint8)]
     assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, without)) is None
 
 
