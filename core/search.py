@@ -248,13 +248,14 @@ class LimbSearch:
                 cost[:, v], area[v], _ = scored
         return cost, area
 
-    def _view_cost(self, view: Camera, fg: np.ndarray, Ak, Ck, A, C, rest, kept=None
-                   ) -> tuple | None:
+    def _view_cost(self, view: Camera, fg: np.ndarray, Ak, Ck, A, C, rest, kept=None,
+                   with_area: bool = True) -> tuple | None:
         """Outlines Ak, Ck (K candidates of B blobs each) scored in one view: per candidate
         the cost of covering ``fg``'s pixels where the blobs ``rest`` of A, C (every blob's
-        ``blob_frames``) do not, the first candidate's area, and the box with its gains'
-        row prefix sums (``_gain_sums``). ``kept``: such a box and sums from an earlier
-        call, reused where the outlines fit in it. None where they leave the image."""
+        ``blob_frames``) do not, the first candidate's area (None unless ``with_area``),
+        and the box with its gains' row prefix sums (``_gain_sums``). ``kept``: such a box
+        and sums from an earlier call, reused where the outlines fit in it. None where they
+        leave the image."""
         c, half, P = outlines(view, Ak, Ck)
         box = _box(c, half, fg.shape)
         if box is None:
@@ -263,7 +264,8 @@ class LimbSearch:
             kept = box, self._gain_sums(view, fg, A[rest], C[rest], box)
         box, S = kept
         lo, hi = spans(c, half, P, box)
-        return span_sums(lo, hi, S), _area(lo[:1], hi[:1], S.shape), kept
+        area = _area(lo[:1], hi[:1], S.shape) if with_area else None
+        return span_sums(lo, hi, S), area, kept
 
     def _allowed(self, limb: _Limb, pose: BodyPose, cands: np.ndarray) -> np.ndarray:
         """Which candidates keep every limited hinge within its range (or no farther out of
@@ -299,8 +301,8 @@ class LimbSearch:
             if stage == 0:
                 area = 0.0
             for v, (view, fg) in enumerate(zip(views, fgs)):
-                scored = None if fg is None else self._view_cost(view, fg, Ak, Ck, A, C, rest,
-                                                                 sums.get(v))
+                scored = None if fg is None else self._view_cost(
+                    view, fg, Ak, Ck, A, C, rest, sums.get(v), with_area=stage == 0)
                 if scored is None:
                     continue
                 view_cost, view_area, sums[v] = scored
