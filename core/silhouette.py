@@ -4,17 +4,18 @@ long, where brightness constancy only reaches a blob's width.
 Each view's backdrop is the key frame with the body taken out (see ``Backdrop``), or the
 clean plate the user gives (the scene without the body); a pixel is foreground where it
 differs from the backdrop by more than a threshold set from the image's own noise (the
-cameras stand still, or only turn about their centres: ``TurningBackdrop``). In colour
-footage, a changed pixel whose colour is the backdrop's, darkened or lightened as a shadow
-does, is unsure: the body's own cast shadow, or one the key frame held, on a backdrop whose
-colour shows it (on a colourless one a shadow cannot be told from a grey body, and it stays
-foreground). Two chamfer terms compare
-the blobs' projection (a label map) with the foreground, each in both directions:
-foreground pixels no blob covers pull the nearest covered pixel toward them, and covered
-pixels off the foreground are pulled to the nearest foreground pixel; unsure pixels do
-neither. Distances are in level pixels, capped so that clutter far from the body cannot
-pull. A foreground map holds one code per pixel: ``BACKDROP``, ``FOREGROUND`` or ``UNSURE``
-(a boolean mask is a map with no unsure pixels).
+cameras stand still, or only turn about their centres: ``TurningBackdrop``), in brightness
+or, in colour footage from a still camera, in colour (a body as bright as the wall behind
+it). In colour footage, a changed pixel whose colour is the backdrop's, darkened or
+lightened as a shadow does, is unsure: the body's own cast shadow, or one the key frame
+held, on a backdrop whose colour shows it (on a colourless one a shadow cannot be told from
+a grey body, and it stays foreground). Two chamfer terms compare the blobs' projection (a
+label map) with the foreground, each in both directions: foreground pixels no blob covers
+pull the nearest covered pixel toward them, and covered pixels off the foreground are
+pulled to the nearest foreground pixel; unsure pixels do neither. Distances are in level
+pixels, capped so that clutter far from the body cannot pull. A foreground map holds one
+code per pixel: ``BACKDROP``, ``FOREGROUND`` or ``UNSURE`` (a boolean mask is a map with no
+unsure pixels).
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ TURNING_REACH = 1  # pixels a turning camera's frame may lie off its backdrop (`
 TURNING_SOURCES = 12  # latest tracked frames a turning camera's backdrop is drawn from
 SHADOW_CHROMA = 6.0  # colour off the backdrop's, in its median over pixels that stay the same,
 # still called the backdrop's own
+_CHANNEL_SUM = np.ones((1, 3), np.float32)  # ``cv2.transform``: a pixel's channels summed
 
 
 class Backdrop:
@@ -130,8 +132,10 @@ class Backdrop:
     def foreground(self, grey: np.ndarray, colour: np.ndarray | None = None,
                    against: tuple | None = None) -> np.ndarray:
         """Foreground map (H, W) of a full-resolution frame (grey, and colour or None):
-        pixels off the backdrop, specks removed, are ``FOREGROUND``, or ``UNSURE`` where
-        their colour is the backdrop's shaded (``shaded``). Holes are kept: the gap between
+        pixels off the backdrop in brightness or in colour (``recoloured``; not a turning
+        camera's, resampled, whose edges would all be off by a pixel's colour), specks
+        removed, are ``FOREGROUND``, or ``UNSURE`` where their colour is the backdrop's
+        shaded (``shaded``). Holes are kept: the gap between
         an arm and the trunk is one. A frame a few pixels larger or smaller than the
         backdrop is compared where they overlap (top-left corners together); the rest is
         backdrop. ``against``: (grey, colour or None, unknown) of the frame's own size to
@@ -147,9 +151,12 @@ class Backdrop:
         else:
             off = np.abs(seen - image)
         fg[:h, :w] = off > self.threshold
+        in_colour = self.chroma_noise is not None and colour is not None and \
+            backdrop_colour is not None and colour.shape == backdrop_colour.shape
+        if in_colour and not self.reach:
+            fg[:h, :w] |= self.recoloured(colour[:h, :w], backdrop_colour[:h, :w])
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
-        if self.chroma_noise is not None and colour is not None and \
-                backdrop_colour is not None and colour.shape == backdrop_colour.shape:
+        if in_colour:
             off_backdrop = fg > 0
             unsure = np.zeros(fg.shape, np.uint8)
             unsure[off_backdrop] = self.shaded(colour[off_backdrop], backdrop_colour[off_backdrop])
@@ -159,6 +166,24 @@ class Backdrop:
         if unknown is not None:
             fg[unknown] = UNSURE
         return fg
+
+    def recoloured(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
+        """Which pixels of a frame's colour ``seen`` (H, W, 3) are no shade of their
+        ``backdrop`` colour (H, W, 3): off every brightness of it by over ``SHADOW_CHROMA``
+        times the footage's colour noise, the shadow test's own bar. A body the backdrop's
+        brightness (a grey figure on a sunlit brick wall: a third of its pixels) still
+        differs from it in colour. Judged on 2 x 2 blocks, the resolution compressed footage
+        keeps its colour at (4:2:0), and a quarter of the work."""
+        h, w = seen.shape[:2]
+        half = ((w + 1) // 2, (h + 1) // 2)
+        f, b = (cv2.resize(x.astype(np.float32), half, interpolation=cv2.INTER_AREA)
+                for x in (seen, backdrop))
+        fb, bb, ff = (cv2.transform(cv2.multiply(x, y), _CHANNEL_SUM)
+                      for x, y in ((f, b), (b, b), (f, f)))
+        scale = fb / np.maximum(bb, 1.0)  # as ``_chroma``'s
+        off_sq = ff - scale * (2 * fb - scale * bb)  # |f - scale b|^2
+        out = (off_sq > (SHADOW_CHROMA * self.chroma_noise) ** 2).astype(np.uint8)
+        return cv2.resize(out, (w, h), interpolation=cv2.INTER_NEAREST)
 
     def shaded(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
         """Which pixels' colours ``seen`` (N, 3) are their ``backdrop`` colours (N, 3)

@@ -156,6 +156,61 @@ def test_a_shadow_on_a_colourless_wall_stays_foreground():
     assert np.mean(fg[shadow | body] == FOREGROUND) > 0.95
 
 
+def test_a_body_as_bright_as_its_wall_is_told_by_its_colour():
+    """A grey body exactly as bright as the tan wall behind it: brightness alone finds none
+    of it, its colour all of it; its shadow beside it stays unsure and the bare wall
+    backdrop."""
+    shape = (120, 160)
+    rng = np.random.default_rng(4)
+    texture = cv2.GaussianBlur(rng.uniform(0.6, 1.0, shape).astype(np.float32), (0, 0), 1.5)
+    wall = texture[..., None] * np.float32((0.4, 0.65, 0.9))
+
+    def frame(x):
+        body, shadow = _disc(shape, (x, 60), 16), _disc(shape, (x + 12, 52), 18)
+        shadow &= ~body
+        img = wall.copy()
+        img[shadow] *= 0.45
+        img[body] = cv2.cvtColor(wall, cv2.COLOR_BGR2GRAY)[body][:, None]  # grey, as bright
+        img = np.clip(img + rng.normal(0, 0.005, img.shape), 0, 1)
+        colour = (img * 255 + 0.5).astype(np.uint8)
+        grey = cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY).astype(np.float32) / 255
+        return grey, colour, body, shadow
+
+    g0, c0, body0, shadow0 = frame(40)
+    others = [frame(x)[:2] for x in (70, 100, 130)]
+    bd = Backdrop(g0, body0, others, colour=c0)
+    g, c, body, shadow = frame(110)
+    assert np.mean(Backdrop(g0, body0, [(f, None) for f, _ in others]).foreground(g)[body]
+                   == FOREGROUND) < 0.05
+    fg = bd.foreground(g, c)
+    assert np.mean(fg[body] == FOREGROUND) > 0.97
+    assert np.mean(fg[shadow] == UNSURE) > 0.9
+    bare = ~bd.widen(body | shadow | body0 | shadow0)  # the key frame's shadow lifts: unsure
+    assert np.mean(fg[bare] == BACKDROP) > 0.99
+
+
+def test_a_recoloured_pixel_is_its_two_by_two_blocks_colour_off_the_backdrops_shades():
+    """``Backdrop.recoloured`` against ``_chroma`` on each 2 x 2 block's mean colours."""
+    rng = np.random.default_rng(6)
+    shape = (40, 60)
+    backdrop = rng.integers(0, 256, (*shape, 3), dtype=np.uint8)
+    scale = rng.uniform(0.3, 1.5, (*shape, 1))
+    seen = np.clip(backdrop * scale + rng.normal(0, 12, (*shape, 3)), 0, 255).astype(np.uint8)
+    bd = Backdrop(np.zeros(shape, np.float32), np.zeros(shape, bool))
+    bd.chroma_noise = 1.5
+    got = bd.recoloured(seen, backdrop)
+
+    def blocks(img):
+        return img.astype(float).reshape(shape[0] // 2, 2, shape[1] // 2, 2, 3).mean((1, 3))
+
+    off, _ = silhouette._chroma(blocks(seen).reshape(-1, 3), blocks(backdrop).reshape(-1, 3))
+    bar = silhouette.SHADOW_CHROMA * bd.chroma_noise
+    want = (off > bar).reshape(shape[0] // 2, shape[1] // 2).repeat(2, 0).repeat(2, 1)
+    near = np.abs(off - bar).reshape(want[::2, ::2].shape).repeat(2, 0).repeat(2, 1) < 1e-3
+    assert 0.2 < want.mean() < 0.8
+    np.testing.assert_array_equal(got.astype(bool)[~near], want[~near])
+
+
 def test_unsure_pixels_neither_pull_nor_are_pulled():
     shape = (60, 80)
     labels = np.full(shape, -1)
