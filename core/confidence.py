@@ -31,8 +31,8 @@ from .raycast import BlobStack
 from .skeleton import BALL, HINGE, Skeleton
 
 MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its pixels are visible there
-DOUBT = 0.3  # a limb is flagged below this confidence
-CLEAR = 0.8  # a limb flagged on the frame before stays flagged up to this one
+DOUBT = 0.35  # a limb is flagged below this confidence
+CLEAR = 0.9  # a limb flagged on the frame before stays flagged up to this one
 AXIS_POINTS = 9  # points along each blob's long axis whose silhouette is read
 AXIS_REACH = 0.8  # of the blob's long radius, either side of its centre
 UNSEEN, UNSURE_FLAG = "unseen", "unsure"
