@@ -133,9 +133,11 @@ class Backdrop:
                    against: tuple | None = None) -> np.ndarray:
         """Foreground map (H, W) of a full-resolution frame (grey, and colour or None):
         pixels off the backdrop in brightness or in colour (``recoloured``; not a turning
-        camera's, resampled, whose edges would all be off by a pixel's colour), specks
-        removed, are ``FOREGROUND``, or ``UNSURE`` where their colour is the backdrop's
-        shaded (``shaded``). Holes are kept: the gap between
+        camera's, resampled, whose edges would all be off by a pixel's colour, nor where
+        the footage's colour noise reads 0: a grey scene stored in colour, whose colour is
+        only rounding, has no noise to set the colour's bar by), specks removed, are
+        ``FOREGROUND``, or ``UNSURE`` where their colour is the backdrop's shaded
+        (``shaded``). Holes are kept: the gap between
         an arm and the trunk is one. A frame a few pixels larger or smaller than the
         backdrop is compared where they overlap (top-left corners together); the rest is
         backdrop. ``against``: (grey, colour or None, unknown) of the frame's own size to
@@ -153,7 +155,7 @@ class Backdrop:
         fg[:h, :w] = off > self.threshold
         in_colour = self.chroma_noise is not None and colour is not None and \
             backdrop_colour is not None and colour.shape == backdrop_colour.shape
-        if in_colour and not self.reach:
+        if in_colour and not self.reach and self.chroma_noise > 0:
             fg[:h, :w] |= self.recoloured(colour[:h, :w], backdrop_colour[:h, :w])
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
         if in_colour:

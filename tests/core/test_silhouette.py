@@ -189,6 +189,31 @@ def test_a_body_as_bright_as_its_wall_is_told_by_its_colour():
     assert np.mean(fg[bare] == BACKDROP) > 0.99
 
 
+def test_a_grey_scene_stored_in_colour_is_read_by_brightness():
+    """A grey wall and body stored in colour, a level of colour off grey here and there (a
+    renderer's rounding): the colour noise reads 0, and no pixel off the body is called
+    foreground for its colour."""
+    shape = (120, 160)
+    rng = np.random.default_rng(8)
+    wall = cv2.GaussianBlur(rng.uniform(0.2, 0.8, shape).astype(np.float32), (0, 0), 2.0)
+
+    def frame(x):
+        body = _disc(shape, (x, 60), 16)
+        img = np.where(body, 0.95, wall)
+        colour = np.repeat((img[..., None] * 250 + 2.5).astype(np.int16), 3, axis=2)
+        rounding = rng.integers(-1, 2, colour.shape) * (rng.random(shape) < 0.15)[..., None]
+        colour = (colour + rounding).astype(np.uint8)
+        return cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY).astype(np.float32) / 255, colour, body
+
+    g0, c0, body0 = frame(40)
+    bd = Backdrop(g0, body0, [frame(x)[:2] for x in (70, 100, 130)], colour=c0)
+    assert bd.chroma_noise == 0 and bd.still
+    g, c, body = frame(110)
+    fg = bd.foreground(g, c)
+    assert np.mean(fg[~bd.widen(body | body0)] == BACKDROP) > 0.99
+    assert np.mean(fg[body] == FOREGROUND) > 0.97
+
+
 def test_a_recoloured_pixel_is_its_two_by_two_blocks_colour_off_the_backdrops_shades():
     """``Backdrop.recoloured`` against ``_chroma`` on each 2 x 2 block's mean colours."""
     rng = np.random.default_rng(6)
