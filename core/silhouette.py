@@ -137,12 +137,12 @@ class Backdrop:
         the footage's colour noise reads 0: a grey scene stored in colour, whose colour is
         only rounding, has no noise to set the colour's bar by), specks removed, are
         ``FOREGROUND``, or ``UNSURE`` where their colour is the backdrop's shaded
-        (``shaded``). Holes are kept: the gap between
-        an arm and the trunk is one. A frame a few pixels larger or smaller than the
-        backdrop is compared where they overlap (top-left corners together); the rest is
-        backdrop. ``against``: (grey, colour or None, unknown) of the frame's own size to
-        compare with instead of this backdrop's image (a turning camera's, brought into the
-        frame's view: ``TurningBackdrop``), its unknown pixels ``UNSURE``."""
+        (``shaded``). Holes are kept: the gap between an arm and the trunk is one. A frame
+        a few pixels larger or smaller than the backdrop is compared where they overlap
+        (top-left corners together); the rest is backdrop. ``against``: (grey, colour or
+        None, unknown) of the frame's own size to compare with instead of this backdrop's
+        image (a turning camera's, brought into the frame's view: ``TurningBackdrop``), its
+        unknown pixels ``UNSURE``."""
         image, backdrop_colour, unknown = against or (self.image, self.colour, None)
         h, w = (min(a, b) for a, b in zip(grey.shape, image.shape))
         fg = np.zeros(grey.shape, np.uint8)
