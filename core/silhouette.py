@@ -47,7 +47,6 @@ TURNING_REACH = 1  # pixels a turning camera's frame may lie off its backdrop (`
 TURNING_SOURCES = 12  # latest tracked frames a turning camera's backdrop is drawn from
 SHADOW_CHROMA = 6.0  # colour off the backdrop's, in its median over pixels that stay the same,
 # still called the backdrop's own
-_CHANNEL_SUM = np.ones((1, 3), np.float32)  # ``cv2.transform``: a pixel's channels summed
 
 
 class Backdrop:
@@ -169,32 +168,34 @@ class Backdrop:
             fg[unknown] = UNSURE
         return fg
 
+    @property
+    def colour_bar(self) -> float:
+        """How far (0-255 units) a colour may lie off every shade of its backdrop colour
+        and still be called one: ``SHADOW_CHROMA`` times the footage's colour noise."""
+        return SHADOW_CHROMA * self.chroma_noise
+
     def recoloured(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
         """Which pixels of a frame's colour ``seen`` (H, W, 3) are no shade of their
-        ``backdrop`` colour (H, W, 3): off every brightness of it by over ``SHADOW_CHROMA``
-        times the footage's colour noise, the shadow test's own bar. A body the backdrop's
-        brightness (a grey figure on a sunlit brick wall: a third of its pixels) still
-        differs from it in colour. Judged on 2 x 2 blocks, the resolution compressed footage
-        keeps its colour at (4:2:0), and a quarter of the work."""
+        ``backdrop`` colour (H, W, 3): off every brightness of it (``_chroma``) by over
+        ``colour_bar``, the shadow test's own. A body the backdrop's brightness (a grey
+        figure on a sunlit brick wall: a third of its pixels) still differs from it in
+        colour. Judged on 2 x 2 blocks, the resolution compressed footage keeps its colour
+        at (4:2:0), and a quarter of the work."""
         h, w = seen.shape[:2]
         half = ((w + 1) // 2, (h + 1) // 2)
         f, b = (cv2.resize(x.astype(np.float32), half, interpolation=cv2.INTER_AREA)
                 for x in (seen, backdrop))
-        fb, bb, ff = (cv2.transform(cv2.multiply(x, y), _CHANNEL_SUM)
-                      for x, y in ((f, b), (b, b), (f, f)))
-        scale = fb / np.maximum(bb, 1.0)  # as ``_chroma``'s
-        off_sq = ff - scale * (2 * fb - scale * bb)  # |f - scale b|^2
-        out = (off_sq > (SHADOW_CHROMA * self.chroma_noise) ** 2).astype(np.uint8)
-        return cv2.resize(out, (w, h), interpolation=cv2.INTER_NEAREST)
+        off = _chroma(f.reshape(-1, 3), b.reshape(-1, 3))[0].reshape(f.shape[:2])
+        return cv2.resize((off > self.colour_bar).astype(np.uint8), (w, h),
+                          interpolation=cv2.INTER_NEAREST)
 
     def shaded(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
         """Which pixels' colours ``seen`` (N, 3) are their ``backdrop`` colours (N, 3)
         scaled by a shadow falling or lifting (brightness between ``SHADOW_DEPTH`` and its
-        inverse), within ``SHADOW_CHROMA`` times the footage's colour noise, where that
-        backdrop's colour is told from grey at that brightness (else a grey body would pass
-        for its shadow)."""
+        inverse), within ``colour_bar`` of them, where that backdrop's colour is told from
+        grey at that brightness (else a grey body would pass for its shadow)."""
         off, scale = _chroma(seen, backdrop)
-        tell = SHADOW_CHROMA * self.chroma_noise
+        tell = self.colour_bar
         out = (off <= tell) & (scale >= SHADOW_DEPTH) & (scale <= 1 / SHADOW_DEPTH)
         grey = np.repeat(seen[out].astype(np.float32).mean(1, keepdims=True), 3, 1)
         out[out] = _chroma(grey, backdrop[out])[0] > tell  # only where the rest holds

@@ -103,10 +103,11 @@ def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
                                   cv2.pyrDown(fg.astype(np.float32)).shape)
 
 
-def _sunlit(wall_colour, shape=(120, 160), seed=2):
+def _sunlit(wall_colour, shape=(120, 160), seed=2, body_grey=0.2):
     """A textured wall of one colour (BGR, 0-1) with a grey body on it, frame by frame: the
     body (a disc) and its cast shadow (the wall at 0.45 of its light, a disc beside it)
-    move right by 30 pixels a frame. Returns frame k as (grey, colour), the body's and the
+    move right by 30 pixels a frame. ``body_grey``: the body's grey, or None for the wall's
+    own brightness behind it. Returns frame k as (grey, colour), the body's and the
     shadow's pixels."""
     rng = np.random.default_rng(seed)
     texture = cv2.GaussianBlur(rng.uniform(0.6, 1.0, shape).astype(np.float32), (0, 0), 1.5)
@@ -117,7 +118,8 @@ def _sunlit(wall_colour, shape=(120, 160), seed=2):
         shadow &= ~body
         img = wall.copy()
         img[shadow] *= 0.45
-        img[body] = 0.2
+        img[body] = cv2.cvtColor(wall, cv2.COLOR_BGR2GRAY)[body][:, None] \
+            if body_grey is None else body_grey
         img = np.clip(img + rng.normal(0, 0.005, img.shape), 0, 1)
         rgb = (img * 255 + 0.5).astype(np.uint8)
         return (cv2.cvtColor(img.astype(np.float32), cv2.COLOR_BGR2GRAY), rgb), body, shadow
@@ -160,26 +162,11 @@ def test_a_body_as_bright_as_its_wall_is_told_by_its_colour():
     """A grey body exactly as bright as the tan wall behind it: brightness alone finds none
     of it, its colour all of it; its shadow beside it stays unsure and the bare wall
     backdrop."""
-    shape = (120, 160)
-    rng = np.random.default_rng(4)
-    texture = cv2.GaussianBlur(rng.uniform(0.6, 1.0, shape).astype(np.float32), (0, 0), 1.5)
-    wall = texture[..., None] * np.float32((0.4, 0.65, 0.9))
-
-    def frame(x):
-        body, shadow = _disc(shape, (x, 60), 16), _disc(shape, (x + 12, 52), 18)
-        shadow &= ~body
-        img = wall.copy()
-        img[shadow] *= 0.45
-        img[body] = cv2.cvtColor(wall, cv2.COLOR_BGR2GRAY)[body][:, None]  # grey, as bright
-        img = np.clip(img + rng.normal(0, 0.005, img.shape), 0, 1)
-        colour = (img * 255 + 0.5).astype(np.uint8)
-        grey = cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY).astype(np.float32) / 255
-        return grey, colour, body, shadow
-
-    g0, c0, body0, shadow0 = frame(40)
-    others = [frame(x)[:2] for x in (70, 100, 130)]
+    frame = _sunlit((0.4, 0.65, 0.9), seed=4, body_grey=None)
+    (g0, c0), body0, shadow0 = frame(0)
+    others = [frame(k)[0] for k in (1, 2, 3)]
     bd = Backdrop(g0, body0, others, colour=c0)
-    g, c, body, shadow = frame(110)
+    (g, c), body, shadow = frame(3)
     assert np.mean(Backdrop(g0, body0, [(f, None) for f, _ in others]).foreground(g)[body]
                    == FOREGROUND) < 0.05
     fg = bd.foreground(g, c)
