@@ -5,9 +5,10 @@ and scored against the capture beside two references on the same frames.
                           [--clips NAME,...] [--looks NAME,...] [--workers N] [--write PATH]
 
 Each clip (a capture of ``captures.NAMINGS``) is rendered once per look
-(``suite_footage.LOOKS``) into ``.cache/suite/`` and tracked through ``python -m core
-track``, as a user runs it: three calibrated views (the lower back free) and one lateral
-view (the paper's 19 degrees of freedom), at 15 fps, and with the full suite at 30 fps too.
+(``suite_footage.LOOKS``) into ``.cache/suite/``, ``--workers`` looks at once, and tracked
+through ``python -m core track``, as a user runs it: three calibrated views (the lower back
+free) and one lateral view (the paper's 19 degrees of freedom), at 15 fps, and with the full
+suite at 30 fps too.
 The tracker's body is what a job gets without blobs of its own (``Skeleton.default_blobs``),
 its hinges' axes the capture's own. Scored: the limb-direction error over the eight limbs
 (a run that stops keeps its last pose, as a user's keys would), beside the first frame held
@@ -18,19 +19,20 @@ run is tracked from the clip's first three frames (``--starts``), each posed by 
 and scored by the mean, with the lowest and highest beside it. ``--quick`` (the check for
 every change, a few minutes once the footage is rendered): the CMU clips at 15 fps, from
 the first frame alone. The Bandai Namco clips are non-commercial and never stored in the
-repository: give the folder that holds them (``bn_*.bvh``) to include them. Two trackers
-run at once, one per core of a two-core machine; the tracking speed of a run alone, as a
-user's, is ``--workers 1`` (nothing else running).
+repository: give the folder that holds them (``bn_*.bvh``) to include them. Two renderers,
+then two trackers, run at once, one per core of a two-core machine; the tracking speed of a
+run alone, as a user's, is ``--workers 1`` (nothing else running).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import statistics
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +50,7 @@ from suite_footage import (  # noqa: E402
     VIEWS,
     Clip,
     look_cameras,
+    look_rendered,
     render_look,
     stage,
 )
@@ -277,6 +280,24 @@ def settings_phrase(settings: dict) -> str:
     return f"the default settings but {given}"
 
 
+def render_missing(clips: list[Clip], looks: list[str], workers: int, t0: float) -> None:
+    """Render the footage of every clip (staged) in every look that is not rendered yet,
+    ``workers`` looks at once, each in a process of its own (Blender renders one scene at a
+    time, on one core here)."""
+    todo = [(clip.name, CACHE / slug(clip.name), look) for clip in clips for look in looks
+            if not look_rendered(CACHE / slug(clip.name), look, CACHE / slug(clip.name)
+                                 / slug(look))]
+    if not todo:
+        return
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        running = {pool.submit(render_look, clip_dir, look, clip_dir / slug(look)):
+                   (name, look) for name, clip_dir, look in todo}
+        for done in as_completed(running):
+            name, look = running[done]
+            print(f"{name}, {look}: rendered {done.result()} images"
+                  f" ({time.perf_counter() - t0:.0f} s)", flush=True)
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -290,7 +311,8 @@ def main(argv=None) -> int:
     ap.add_argument("--starts", type=int, help="starting frames each clip, look and run is "
                     "tracked from, its scores averaged (default 3, or 1 with --quick)")
     ap.add_argument("--workers", type=int, default=2,
-                    help="trackers run at once (default 2, one per core; 1 for speed alone)")
+                    help="renderers, then trackers, run at once (default 2, one per core; 1 "
+                    "for a tracker's speed alone)")
     ap.add_argument("--write", type=Path, help="also write the tables to this markdown file")
     a = ap.parse_args(argv)
     clips = list(CLIPS)
@@ -310,13 +332,11 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     jobs = []
     for clip in clips:
+        stage(clip, CACHE / slug(clip.name))
+    render_missing(clips, looks, a.workers, t0)
+    for clip in clips:
         clip_dir = CACHE / slug(clip.name)
-        stage(clip, clip_dir)
         for look in looks:
-            rendered = render_look(clip_dir, look, clip_dir / slug(look))
-            if rendered:
-                print(f"{clip.name}, {look}: rendered {rendered} images"
-                      f" ({time.perf_counter() - t0:.0f} s)", flush=True)
             jobs += [((clip.name, look, run), k, write_job(clip_dir, look, run, settings, k))
                      for run in runs for k in range(starts)]
     scored: dict[tuple, list[dict]] = {}

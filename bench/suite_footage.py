@@ -35,7 +35,7 @@ from walk_footage import (
     place_camera,
 )
 
-from core.bvh import write_bvh
+from core.bvh import read_bvh, write_bvh
 from core.skeleton import skeleton_from_bvh
 
 WIDTH, HEIGHT = 480, 360
@@ -182,8 +182,6 @@ def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
     cams = json.loads((clip_dir / "cameras.json").read_text())
     if look.distance is None:
         return cams
-    from core.bvh import read_bvh
-
     root = read_bvh(clip_dir / "truth.bvh").poses()[1]
     out = {}
     for v, cam in cams.items():
@@ -227,27 +225,41 @@ def stage(clip: Clip, out: Path) -> dict:
     return cams
 
 
-def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
-    """Render every frame of ``clip_dir/truth.bvh`` in every view in the look into
-    ``out/<view>/``; returns how many images were rendered now (0: all were there)."""
-    import bpy
-    import cv2
-
+def _look_stamp(clip_dir: Path, look_name: str) -> dict:
+    """What ``out/look.json`` says of a look rendered whole: the look, the clip's frames."""
     look = LOOKS[look_name]
-    stamp = out / "look.json"
-    truth = clip_dir / "truth.bvh"
-    from core.bvh import read_bvh
-
-    n = len(read_bvh(truth).motion)
-    meta = {"look": asdict(look), "frames": n, "version": 1}
+    meta = {"look": asdict(look), "frames": len(read_bvh(clip_dir / "truth.bvh").motion),
+            "version": 1}
     if look.distance is None:  # as the looks' stamps were before lenses were looks
         del meta["look"]["distance"], meta["look"]["pan"]
     if look.pan:  # rendered again since its backdrop turns with the camera (it slid before)
         meta["backdrop"] = "turned"
-    ext = "jpg" if look.jpeg else "png"
-    done = stamp.is_file() and json.loads(stamp.read_text()) == meta
-    if done and all((out / v / f"{n - 1:04d}.{ext}").is_file() for v in VIEWS):
+    return meta
+
+
+def look_rendered(clip_dir: Path, look_name: str, out: Path) -> bool:
+    """Whether ``out`` holds the look's footage of ``clip_dir/truth.bvh``, every frame of
+    every view, rendered with the look as it is now."""
+    meta = _look_stamp(clip_dir, look_name)
+    stamp, n = out / "look.json", meta["frames"]
+    ext = "jpg" if LOOKS[look_name].jpeg else "png"
+    return stamp.is_file() and json.loads(stamp.read_text()) == meta and all(
+        (out / v / f"{n - 1:04d}.{ext}").is_file() for v in VIEWS)
+
+
+def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
+    """Render every frame of ``clip_dir/truth.bvh`` in every view in the look into
+    ``out/<view>/``; returns how many images were rendered now (0: all were there). Blender
+    renders one scene at a time: looks are rendered at once in processes of their own."""
+    if look_rendered(clip_dir, look_name, out):
         return 0
+    import bpy
+    import cv2
+
+    look = LOOKS[look_name]
+    meta = _look_stamp(clip_dir, look_name)
+    stamp, n, truth = out / "look.json", meta["frames"], clip_dir / "truth.bvh"
+    ext = "jpg" if look.jpeg else "png"
     cams = look_cameras(clip_dir, look)
     sk = skeleton_from_bvh(read_bvh(truth))
     parts = Parts.of(sk.names)

@@ -191,6 +191,39 @@ def test_a_run_from_a_later_frame_is_posed_there_and_takes_every_step_th_frame_f
     np.testing.assert_allclose(job["views"][0]["camera"]["t"], np.array(full["t"])[3::2])
 
 
+def test_a_look_counts_as_rendered_only_whole_and_as_the_look_is_now(tmp_path, monkeypatch):
+    """``look_rendered``: every view's last frame there under the look's own stamp; a view
+    short of its last frame, or a stamp of the look as it was, asks for it again. Looks
+    already rendered start no renderer."""
+    import suite
+    from suite import CLIPS, render_missing, slug
+    from suite_footage import LOOKS, VIEWS, _look_stamp, look_rendered, stage
+
+    monkeypatch.setattr(suite, "CACHE", tmp_path)
+    clip_dir = tmp_path / slug(CLIPS[0].name)
+    stage(CLIPS[0], clip_dir)
+    out = clip_dir / slug("park video")
+    n = len(read_bvh(clip_dir / "truth.bvh").motion)
+    assert LOOKS["park video"].jpeg
+    for v in VIEWS:
+        (out / v).mkdir(parents=True)
+        (out / v / f"{n - 1:04d}.jpg").write_bytes(b"")
+    stamp = _look_stamp(clip_dir, "park video")
+    (out / "look.json").write_text(json.dumps(stamp))
+    assert look_rendered(clip_dir, "park video", out)
+
+    def no_renderer(*args, **kwargs):
+        raise AssertionError("a renderer was started for footage already rendered")
+
+    monkeypatch.setattr(suite, "ProcessPoolExecutor", no_renderer)
+    render_missing([CLIPS[0]], ["park video"], 2, 0.0)
+    (out / VIEWS[-1] / f"{n - 1:04d}.jpg").unlink()
+    assert not look_rendered(clip_dir, "park video", out)
+    (out / VIEWS[-1] / f"{n - 1:04d}.jpg").write_bytes(b"")
+    (out / "look.json").write_text(json.dumps({**stamp, "look": {**stamp["look"], "blur": 1}}))
+    assert not look_rendered(clip_dir, "park video", out)
+
+
 def test_runs_from_several_starts_are_scored_by_their_mean_and_summed_counts():
     from suite import over_starts
 
