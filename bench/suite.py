@@ -49,6 +49,7 @@ from suite_footage import (  # noqa: E402
     VIDEO_FPS,
     VIEWS,
     Clip,
+    frame_ext,
     look_cameras,
     look_rendered,
     render_look,
@@ -101,7 +102,7 @@ def write_job(clip_dir: Path, look: str, run: str, settings: dict, start: int = 
     sk = skeleton_from_bvh(truth)
     R, _ = truth.poses()
     cams = look_cameras(clip_dir, LOOKS[look])
-    ext = "jpg" if LOOKS[look].jpeg else "png"
+    ext = frame_ext(LOOKS[look])
     frames = range(start, len(R), step)
     for cam in cams.values():
         if np.ndim(cam["R"]) == 3:  # a camera that moves: its pose on the run's frames
@@ -284,9 +285,9 @@ def render_missing(clips: list[Clip], looks: list[str], workers: int, t0: float)
     """Render the footage of every clip (staged) in every look that is not rendered yet,
     ``workers`` looks at once, each in a process of its own (Blender renders one scene at a
     time, on one core here)."""
-    todo = [(clip.name, CACHE / slug(clip.name), look) for clip in clips for look in looks
-            if not look_rendered(CACHE / slug(clip.name), look, CACHE / slug(clip.name)
-                                 / slug(look))]
+    todo = [(clip.name, CACHE / slug(clip.name), look) for clip in clips for look in looks]
+    todo = [(name, clip_dir, look) for name, clip_dir, look in todo
+            if not look_rendered(clip_dir, look, clip_dir / slug(look))]
     if not todo:
         return
     with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:

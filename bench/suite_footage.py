@@ -240,26 +240,33 @@ def _look_stamp(clip_dir: Path, look_name: str) -> dict:
 def look_rendered(clip_dir: Path, look_name: str, out: Path) -> bool:
     """Whether ``out`` holds the look's footage of ``clip_dir/truth.bvh``, every frame of
     every view, rendered with the look as it is now."""
-    meta = _look_stamp(clip_dir, look_name)
-    stamp, n = out / "look.json", meta["frames"]
-    ext = "jpg" if LOOKS[look_name].jpeg else "png"
+    return _whole(out, _look_stamp(clip_dir, look_name), LOOKS[look_name])
+
+
+def _whole(out: Path, meta: dict, look: Look) -> bool:
+    """Whether ``out`` is stamped ``meta`` and holds every view's last frame."""
+    stamp, last = out / "look.json", f"{meta['frames'] - 1:04d}.{frame_ext(look)}"
     return stamp.is_file() and json.loads(stamp.read_text()) == meta and all(
-        (out / v / f"{n - 1:04d}.{ext}").is_file() for v in VIEWS)
+        (out / v / last).is_file() for v in VIEWS)
+
+
+def frame_ext(look: Look) -> str:
+    """The file type of the look's frames."""
+    return "jpg" if look.jpeg else "png"
 
 
 def render_look(clip_dir: Path, look_name: str, out: Path) -> int:
     """Render every frame of ``clip_dir/truth.bvh`` in every view in the look into
     ``out/<view>/``; returns how many images were rendered now (0: all were there). Blender
     renders one scene at a time: looks are rendered at once in processes of their own."""
-    if look_rendered(clip_dir, look_name, out):
+    look, meta = LOOKS[look_name], _look_stamp(clip_dir, look_name)
+    if _whole(out, meta, look):
         return 0
     import bpy
     import cv2
 
-    look = LOOKS[look_name]
-    meta = _look_stamp(clip_dir, look_name)
     stamp, n, truth = out / "look.json", meta["frames"], clip_dir / "truth.bvh"
-    ext = "jpg" if look.jpeg else "png"
+    ext = frame_ext(look)
     cams = look_cameras(clip_dir, look)
     sk = skeleton_from_bvh(read_bvh(truth))
     parts = Parts.of(sk.names)
