@@ -7,9 +7,11 @@ frame the user corrected takes the user's pose and becomes the key frame after i
 every view looks along one line the body is tracked side-on (``core.side_on``; its root's
 turn toward or away from the camera held), decided from the first pose. A frame whose
 residual jumps, whose body leaves the images or whose system is degenerate is reported as
-diverged instead of being accepted. A camera that moves (a pan, a handheld phone solved
-in Blender) is given per frame; each frame is seen through its cameras as they stood
-then, and the root's motion stays the body's own, in the world;
+diverged instead of being accepted; a residual that climbs over several frames (the body
+turning sides to the cameras that the key frame does not show) is no jump, and the limbs'
+checks report it. A camera that moves (a pan, a handheld phone solved in Blender) is given
+per frame; each frame is seen through its cameras as they stood then, and the root's motion
+stays the body's own, in the world;
 a camera that only turns about its centre keeps its silhouette (``core.silhouette``).
 """
 
@@ -220,7 +222,8 @@ class Tracker(FrameFit):
                 continue
             with one_blas_thread():
                 res = self._next_frame(history, key, key_frame, frame, residuals)
-            residuals.append(res.residual)
+            if np.isfinite(res.residual):
+                residuals.append(res.residual)
             self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
                                 for f in (key_frame, prev.frame, frame)})
             yield res
@@ -248,17 +251,31 @@ class Tracker(FrameFit):
             return res
         if not all(np.isfinite(res.pose.rotations).flat):
             res.diverged, res.reason = True, "the solution is not finite"
-        elif residuals and res.residual > self.settings.divergence_ratio * max(
-                float(np.median(residuals)), self.settings.noise_floor):
-            res.diverged = True
-            res.reason = (f"residual {res.residual:.4f} is over "
-                          f"{self.settings.divergence_ratio}x the median so far "
-                          f"({np.median(residuals):.4f})")
+        elif why := self._residual_jump(res.residual, residuals):
+            res.diverged, res.reason = True, why
         else:
             if self.hold_turn_in_depth:
                 res.turned = turned_from(key, res.pose)
             self._learn_backdrops(res)
         return res
+
+    def _residual_jump(self, residual: float, residuals: list[float]) -> str:
+        """Why a frame's ``residual`` says the fit broke, given the tracked frames' before it
+        (finite ones, in order), or "" if it does not: it must be over ``divergence_ratio``
+        times their median (floored at ``noise_floor``) and over ``divergence_jump`` times the
+        last one's. A break is sudden; a residual that climbs over several frames is the body
+        turning sides to the cameras that the key frame does not show."""
+        if not residuals:
+            return ""
+        s = self.settings
+        median, last = float(np.median(residuals)), residuals[-1]
+        if residual <= s.divergence_ratio * max(median, s.noise_floor) or \
+                residual <= s.divergence_jump * last:
+            return ""
+        jump = f" and {s.divergence_jump:g}x the frame before's ({last:.4f})" \
+            if s.divergence_jump > 0 else ""
+        return (f"residual {residual:.4f} is over {s.divergence_ratio:g}x the median so far "
+                f"({median:.4f}){jump}")
 
 
 def track(
