@@ -188,22 +188,26 @@ def held_still(truth: tuple) -> tuple:
     return np.repeat(R[:1], len(R), 0), np.repeat(p[:1], len(p), 0)
 
 
-def best_fit(sk: Skeleton, truth: tuple) -> tuple:
+def best_fit(sk: Skeleton, truth: tuple, root_axis: np.ndarray | None = None) -> tuple:
     """The pose with the skeleton's tracked degrees of freedom (and a free root) that best fits
     the true 3-D joint positions, frame by frame; untracked joints keep the first frame's
-    rotation, hinges turn about their axis from the first frame's rotation."""
+    rotation, hinges turn about their axis from the first frame's rotation. With
+    ``root_axis`` (a world direction) the root turns about it alone, as a body tracked
+    side-on turns about the line of sight."""
     R_true, p_true = truth
     dof_joint, dof_axis = sk.dof_joints_and_axes()
     base = R_true[0].copy()
     target = world_points(sk, R_true, p_true)
+    turn = 3 if root_axis is None else 1  # the root's turn parameters, after its position
+    axis = None if root_axis is None else np.asarray(root_axis, float) / np.linalg.norm(root_axis)
 
     def pose_of(x):
         R = base.copy()
-        R[0] = se3.exp_so3(x[3:6]) @ base[0]
-        k = 6
+        R[0] = se3.exp_so3(x[3:6] if axis is None else axis * x[3]) @ base[0]
+        k = 3 + turn
         for j in sorted(set(dof_joint.tolist())):
             if sk.kinds[j] == HINGE:
-                R[j] = base[j] @ se3.exp_so3(dof_axis[k - 6] * x[k])
+                R[j] = base[j] @ se3.exp_so3(dof_axis[k - 3 - turn] * x[k])
                 k += 1
             else:
                 R[j] = base[j] @ se3.exp_so3(x[k:k + 3])
@@ -211,7 +215,7 @@ def best_fit(sk: Skeleton, truth: tuple) -> tuple:
         return R, x[:3]
 
     # parameters per DOF in the skeleton's order, which groups each joint's DOFs together
-    n = 6 + len(dof_joint)
+    n = 3 + turn + len(dof_joint)
     x = np.zeros(n)
     x[:3] = p_true[0]
     out_R, out_p = [], []
@@ -219,7 +223,10 @@ def best_fit(sk: Skeleton, truth: tuple) -> tuple:
         def resid(x, f=f):
             R, p = pose_of(x)
             return (sk.world_positions(R, p) - target[f]).ravel()
-        x = least_squares(resid, x, method="lm").x
+        # MINPACK's "lm" stops on its step tolerance short of the minimum here (a thigh
+        # swung 30 degrees left 3 cm of joint error); trust-region steps scaled by the
+        # Jacobian's columns reach it
+        x = least_squares(resid, x, method="trf", x_scale="jac").x
         R, p = pose_of(x)
         out_R.append(R)
         out_p.append(p)

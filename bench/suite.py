@@ -10,18 +10,19 @@ through ``python -m core track``, as a user runs it: three calibrated views (the
 free) and one lateral view (the paper's 19 degrees of freedom), at 15 fps, and with the full
 suite at 30 fps too.
 The tracker's body is what a job gets without blobs of its own (``Skeleton.default_blobs``),
-its hinges' axes the capture's own. Scored: the limb-direction error over the eight limbs
-(a run that stops keeps its last pose, as a user's keys would), beside the first frame held
-still and the best fit of the tracked degrees of freedom to the true joints; for one view
-also how far the limb ends stray in its image, in % of the body's height. Tracking is
-chaotic (a run from the next frame can end several degrees apart), so each clip, look and
-run is tracked from the clip's first three frames (``--starts``), each posed by the capture,
-and scored by the mean, with the lowest and highest beside it. ``--quick`` (the check for
-every change, a few minutes once the footage is rendered): the CMU clips at 15 fps, from
-the first frame alone. The Bandai Namco clips are non-commercial and never stored in the
-repository: give the folder that holds them (``bn_*.bvh``) to include them. Two renderers,
-then two trackers, run at once, one per core of a two-core machine; the tracking speed of a
-run alone, as a user's, is ``--workers 1`` (nothing else running).
+its hinges' axes the capture's own. Scored: the limb-direction error over the eight limbs (a
+run that stops keeps its last pose, as a user's keys would), beside the first frame held
+still and the best fit of the tracked degrees of freedom to the true joints (in one view the
+side-on body's, which cannot turn a limb in depth); for one view also how far the limb ends
+stray in its image, in % of the body's height. Tracking is chaotic (a run from the next
+frame can end several degrees apart), so each clip, look and run is tracked from the clip's
+first three frames (``--starts``), each posed by the capture, and scored by the mean, with
+the lowest and highest beside it. ``--quick`` (the check for every change, a few minutes
+once the footage is rendered): the CMU clips at 15 fps, from the first frame alone. The
+Bandai Namco clips are non-commercial and never stored in the repository: give the folder
+that holds them (``bn_*.bvh``) to include them. Two renderers, then two trackers, run at
+once, one per core of a two-core machine; the tracking speed of a run alone, as a user's, is
+``--workers 1`` (nothing else running).
 """
 
 from __future__ import annotations
@@ -60,7 +61,7 @@ from walk_benchmark import track_job  # noqa: E402
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
-from core.side_on import out_of_side_on  # noqa: E402
+from core.side_on import out_of_side_on, side_on_skeleton  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
 DATA = ROOT / "bench" / "data"
@@ -123,19 +124,26 @@ def write_job(clip_dir: Path, look: str, run: str, settings: dict, start: int = 
     return path
 
 
-_REFERENCES: dict[tuple[Path, str, int], tuple[float, float]] = {}  # (clip, run, start)
+_REFERENCES: dict[tuple, tuple[float, float]] = {}  # (clip, run, start, line of sight)
 
 
-def references(clip_dir: Path, run: str, start: int, sk, truth: tuple, limbs
+def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
                ) -> tuple[float, float]:
-    """Held still and the best fit of the tracked joints, over the run's frames: the same for
-    every look of a clip, so fitted once per clip, run and starting frame."""
-    key = (clip_dir, run, start)
+    """Held still and the best fit of the tracked degrees of freedom over the run's frames.
+    A body tracked side-on (one view) is fitted as the tracker holds it: its depth-blind
+    joints hinges about the line of sight (``side_on_skeleton``), its root turning about
+    that line alone; so the best fit is one view's floor, not three's. The same for every
+    look whose view looks the same way, so fitted once per clip, run, starting frame and
+    line of sight."""
+    sk = job.skeleton
+    body = side_on_skeleton(sk, job.initial) if job.settings.side_on else sk
+    sight = job.initial.views[0].orientation[2] if body is not sk else None
+    key = (clip_dir, run, start, None if sight is None else tuple(np.round(sight, 3)))
     if key not in _REFERENCES:
         names = sk.tracked_joint_names()
         _REFERENCES[key] = tuple(
             evaluate.score(sk, names, pose, truth, limbs=limbs).limb_mean_deg
-            for pose in (evaluate.held_still(truth), evaluate.best_fit(sk, truth)))
+            for pose in (evaluate.held_still(truth), evaluate.best_fit(body, truth, sight)))
     return _REFERENCES[key]
 
 
@@ -187,7 +195,7 @@ def score_run(job_path: Path, run: str, start: int = 0) -> dict:
         est = (np.concatenate([est[0], np.repeat(est[0][-1:], pad, 0)]),
                np.concatenate([est[1], np.repeat(est[1][-1:], pad, 0)]))
     tracker = evaluate.score(sk, sk.tracked_joint_names(), est, truth, limbs=limbs)
-    still, best = references(job_path.parent, run, start, sk, truth, limbs)
+    still, best = references(job_path.parent, run, start, job, truth, limbs)
     row = {"tracker": tracker.limb_mean_deg, "still": still, "best": best,
            "tracked": rep["frames_tracked"], "of": n - 1,
            "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],
@@ -361,8 +369,10 @@ def main(argv=None) -> int:
             "frame(s) (posed there by the capture): tracking is chaotic, so *tracker* is the "
             "mean over those runs, with the lowest and highest beside it. *tracker*, *held "
             "still* (the first frame's pose kept) and *best fit* (the tracked degrees of "
-            "freedom fitted to the true joints, the floor) are limb-direction errors over the "
-            "eight limbs, each a mean over the runs' frames; *image "
+            "freedom fitted to the true joints, the floor; in one view the body tracked "
+            "side-on, its limbs turning in the image plane and its root about the line of "
+            "sight, so what it cannot reach is the limbs' turns in depth) are limb-direction "
+            "errors over the eight limbs, each a mean over the runs' frames; *image "
             "err* (one view) is how far the tracked limb ends stray from the true ones in the "
             "image, in % of the body's height. A run that stops keeps its last pose. See "
             "`bench/suite.py` and `bench/suite_footage.py` for the clips and looks.", ""]

@@ -7,7 +7,7 @@ import numpy as np
 
 from core import se3
 from core.bvh import read_bvh
-from core.skeleton import skeleton_from_bvh
+from core.skeleton import BALL, skeleton_from_bvh
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 
@@ -93,3 +93,43 @@ def test_a_limb_lifted_over_two_frames_starts_from_rest(cmu_walk):
     # frame, so the second keeps the first one's side of the image plane
     sk, truth = _thigh_swung_about_x(cmu_walk, [-25, -15])
     assert evaluate.lifted_from_the_image(sk, truth, [0, 0, 1])["left thigh"] < 1e-6
+
+
+def test_one_views_best_fit_turns_limbs_in_the_image_plane_and_the_root_about_the_sight(
+        cmu_walk):
+    """Fitted as one view along z tracks it (side-on: the ball joints hinges about z, the root
+    turning about z alone), a thigh swung about z is fitted exactly and one swung out of the
+    image plane is off about as far as the limb laid into the image plane; a body turned in
+    depth is off too. The 3-D fit, root free, reaches all three."""
+    from core.camera import View
+    from core.pose import BodyPose
+    from core.side_on import side_on_skeleton
+
+    sk, out_of_plane = _thigh_swung_about_x(cmu_walk, [0, 10, 20, 30, 40])
+    for _, joint, _ in evaluate.LIMBS:
+        sk.kinds[sk.index(joint)] = BALL
+    R, p = out_of_plane[0].copy(), out_of_plane[1]
+    in_plane = R.copy()
+    for f, a in enumerate([0, 10, 20, 30, 40]):
+        in_plane[f, sk.index("LeftHip")] = se3.exp_so3([0.0, 0.0, np.radians(a)])
+    turned = R.copy()
+    for f, a in enumerate([0, 10, 20, 30, 40]):
+        turned[f, 0] = se3.exp_so3([0.0, np.radians(a), 0.0])  # about y: toward the view
+    view = View(se3.Similarity(150.0, np.diag([1.0, -1, -1]), np.zeros(3)), np.zeros(2))
+    body = side_on_skeleton(sk, BodyPose(R[0].copy(), p[0].copy(), [view]))
+    assert body is not sk
+    names = sk.tracked_joint_names()
+
+    def off(fit_body, truth, axis, limb="left thigh"):
+        scores = evaluate.score(sk, names, evaluate.best_fit(fit_body, truth, axis), truth)
+        return scores.limb_deg[limb] if limb else scores.limb_mean_deg
+
+    z = np.array([0.0, 0.0, 1.0])
+    assert off(body, (in_plane, p), z) < 0.01
+    laid = evaluate.in_the_image_plane(sk, out_of_plane, z)["left thigh"]
+    # in the image plane, the thigh is nearest its true direction along its image; fitted to
+    # the joints below it too, a little off that
+    assert laid > 5 and laid - 1e-6 < off(body, out_of_plane, z) < laid + 1.5
+    assert off(body, (turned, p), z, limb=None) > 3
+    for truth in (out_of_plane, (in_plane, p), (turned, p)):
+        assert off(sk, truth, None, limb=None) < 0.01
