@@ -223,9 +223,10 @@ def best_fit(sk: Skeleton, truth: tuple, root_axis: np.ndarray | None = None) ->
         def resid(x, f=f):
             R, p = pose_of(x)
             return (sk.world_positions(R, p) - target[f]).ravel()
-        # MINPACK's "lm" stops on its step tolerance short of the minimum here (a thigh
-        # swung 30 degrees left 3 cm of joint error); trust-region steps scaled by the
-        # Jacobian's columns reach it
+        # MINPACK's lm stops on a small step short of the minimum here (a thigh swung 30
+        # degrees out of the image plane kept 3 cm of joint error, a body turned in depth
+        # 0.5 degrees, even at tolerances of 1e-12); trust-region steps scaled by the
+        # Jacobian's columns reach both, in about the same time
         x = least_squares(resid, x, method="trf", x_scale="jac").x
         R, p = pose_of(x)
         out_R.append(R)
