@@ -1,18 +1,18 @@
 """The tracking run: frame after frame, predict the pose and fit it (``core.frame_fit``).
 
 Each new frame's pose is predicted from the last two (constant velocity; a limited hinge
-that its speed would carry past its limits, or a limb no view saw, is held where it was),
-then fitted to the frame. The first frame's pose is the user's and the first key frame; a
-frame the user corrected takes the user's pose and becomes the key frame after it. Where
-every view looks along one line the body is tracked side-on (``core.side_on``; its root's
-turn toward or away from the camera held), decided from the first pose. A frame whose
-residual jumps, whose body leaves the images or whose system is degenerate is reported as
-diverged instead of being accepted; a residual that climbs over several frames (the body
-turning sides to the cameras that the key frame does not show) is no jump, and the limbs'
-checks report it. A camera that moves (a pan, a handheld phone solved in Blender) is given
-per frame; each frame is seen through its cameras as they stood then, and the root's motion
-stays the body's own, in the world;
-a camera that only turns about its centre keeps its silhouette (``core.silhouette``).
+that its speed would carry past its limits, or a limb no view saw, or one in doubt tracked
+side-on, is held where it was), then fitted to the frame. The first frame's pose is the
+user's and the first key frame; a frame the user corrected takes the user's pose and
+becomes the key frame after it. Where every view looks along one line the body is tracked
+side-on (``core.side_on``; its root's turn toward or away from the camera held), decided
+from the first pose. A frame whose residual jumps, whose body leaves the images or whose
+system is degenerate is reported as diverged instead of being accepted; a residual that
+climbs over several frames (the body turning sides to the cameras that the key frame does
+not show) is no jump, and the limbs' checks report it. A camera that moves (a pan, a
+handheld phone solved in Blender) is given per frame; each frame is seen through its
+cameras as they stood then, and the root's motion stays the body's own, in the world; a
+camera that only turns about its centre keeps its silhouette (``core.silhouette``).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from . import image as imagelib
 from . import se3
 from .blas import one_blas_thread
 from .camera import Camera
-from .confidence import UNSEEN
+from .confidence import UNSEEN, UNSURE_FLAG
 from .errors import InputError
 from .frame_fit import FrameFit, FrameResult
 from .linearize import Kinematics
@@ -139,14 +139,15 @@ class Tracker(FrameFit):
     def predict(self, before: BodyPose, last: BodyPose, held: Sequence[str] = ()) -> BodyPose:
         """Constant-velocity prediction from the poses of the two frames before, except that a
         limited hinge whose turn would carry it past its limits is predicted where it was:
-        carried on, an elbow the limb search had just turned 75 degrees wrapped round past 180
-        and came out bent backward; stopped at the limit, it was 30 degrees off. The joints
-        ``held`` are predicted where they were: limbs no view saw on the last frame (the
-        footage did not show their motion), and those the limb search turned there on two
-        or more views' evidence (views that agree a limb was off: its last step was mostly
-        the error the turn took out, and carried on it threw the limb as far off the other
-        way on the next frame, as a user's correction would). A turn one view bore out keeps
-        its speed: a plate's leg turns 20-40 degrees a cell, past the differential step, and
+        carried on, an elbow the limb search had just turned 75 degrees wrapped round past
+        180 and came out bent backward; stopped at the limit, it was 30 degrees off. The
+        joints ``held`` are predicted where they were: limbs no view saw on the last frame
+        (the footage did not show their motion; tracked side-on, those in doubt too:
+        ``held_joints``), and those the limb search turned there on two or more views'
+        evidence (views that agree a limb was off: its last step was mostly the error the
+        turn took out, and carried on it threw the limb as far off the other way on the
+        next frame, as a user's correction would). A turn one view bore out keeps its
+        speed: a plate's leg turns 20-40 degrees a cell, past the differential step, and
         the search is how its motion is followed at all."""
         pred = extrapolate(before, last, self.settings.prediction_gain)
         held_joints = {self.skeleton.index(name) for name in held}
@@ -237,7 +238,7 @@ class Tracker(FrameFit):
         judge it diverged against the residuals so far, and let the backdrops learn from
         it."""
         prev = history[-1]
-        held = [n for n, why in prev.flagged.items() if why == UNSEEN] + prev.searched
+        held = held_joints(prev, self.hold_turn_in_depth)
         pred = self._filmed_from(
             self.predict(history[-2].pose, prev.pose, held) if len(history) >= 2
             else prev.pose.copy(), frame)
@@ -276,6 +277,17 @@ class Tracker(FrameFit):
             if s.divergence_jump > 0 else ""
         return (f"residual {residual:.4f} is over {s.divergence_ratio:g}x the median so far "
                 f"({median:.4f}){jump}")
+
+
+def held_joints(prev: FrameResult, side_on: bool) -> list[str]:
+    """The joints the next frame predicts where they were on ``prev`` (``Tracker.predict``):
+    its limbs no view saw, and those the limb search turned there on two or more views'
+    evidence; tracked ``side_on``, its limbs in doubt too. One view that disagrees with a
+    limb (most often the far one, half behind the body) has given it no speed worth carrying
+    on. With views from several sides a doubted limb keeps its speed: a shank swinging at 15
+    fps is often in doubt and needs it."""
+    doubt = (UNSEEN, UNSURE_FLAG) if side_on else (UNSEEN,)
+    return [n for n, why in prev.flagged.items() if why in doubt] + prev.searched
 
 
 def track(

@@ -6,8 +6,9 @@ import pytest
 from core import blas, raycast, se3
 from core import silhouette as sil
 from core.camera import View
+from core.confidence import LimbCheck
 from core.errors import InputError
-from core.frame_fit import PointSet
+from core.frame_fit import FrameResult, PointSet
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapolate, n_root_params
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
@@ -16,7 +17,7 @@ from core.settings import TrackerSettings
 from core.side_on import BODY, TURNED, depth_blind_joints, side_on_skeleton, turned_from
 from core.skeleton import HINGE, human_template
 from core.solver import DegenerateSystem
-from core.tracker import Tracker, track
+from core.tracker import Tracker, held_joints, track
 from support.synthetic import render, side_pinhole, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
@@ -806,3 +807,17 @@ def test_a_frame_whose_system_cannot_be_solved_keeps_its_prediction_and_stops_th
     assert last.diverged and "no usable pixels" in last.reason and res.diverged_frames == [2]
     np.testing.assert_array_equal(last.pose.rotations, started[2].rotations)
     assert not res.frames[1].diverged
+
+
+def test_tracked_side_on_a_limb_in_doubt_is_predicted_where_it_was():
+    """One view that disagreed with a limb gave it no speed to carry on: side-on, a limb
+    flagged unsure is held on the next frame as an unseen one is. From several sides it
+    keeps its speed (a shank swinging at 15 fps is often in doubt and needs it)."""
+    checks = {"LeftHip": LimbCheck(0.1, (0.1,)), "RightHip": LimbCheck(0.9, (0.9,)),
+              "LeftElbow": LimbCheck(0.0, (None,)), "RightElbow": LimbCheck(0.5, (0.5,),
+                                                                           doubted=True)}
+    prev = FrameResult(frame=1, pose=None, residual=0.01, iterations=3, converged=True,
+                       limbs=checks, searched=["Neck"])
+    assert sorted(held_joints(prev, side_on=True)) == ["LeftElbow", "LeftHip", "Neck",
+                                                        "RightElbow"]
+    assert sorted(held_joints(prev, side_on=False)) == ["LeftElbow", "Neck"]
