@@ -50,10 +50,11 @@ class TrackerSettings:
     divergence_ratio: float = _knob(3.0, "Flag a frame whose residual exceeds the median so "
                                     "far by this factor")
     divergence_jump: float = _knob(2.0, "Flag such a frame only if its residual also exceeds "
-                                   "the frame before's by this factor: a residual that climbs "
-                                   "over several frames is the body turning new sides to the "
-                                   "cameras, which the limbs' checks report (0: the median "
-                                   "alone)")
+                                   "the lower of the two frames' before it by this factor: a "
+                                   "lost fit breaks within a frame or two, while a residual "
+                                   "that climbs over more is the body turning new sides to "
+                                   "the cameras, which the limbs' checks report (0: the "
+                                   "median alone)")
     min_inside: float = _knob(0.5, "Flag a frame when less of the body than this stays "
                               "inside a view's image")
     stop_on_divergence: bool = _knob(True, "Stop at the first flagged frame")

@@ -252,7 +252,7 @@ class Tracker(FrameFit):
             return res
         if not all(np.isfinite(res.pose.rotations).flat):
             res.diverged, res.reason = True, "the solution is not finite"
-        elif why := self._residual_jump(res.residual, residuals):
+        elif why := residual_jump(res.residual, residuals, self.settings):
             res.diverged, res.reason = True, why
         else:
             if self.hold_turn_in_depth:
@@ -260,23 +260,25 @@ class Tracker(FrameFit):
             self._learn_backdrops(res)
         return res
 
-    def _residual_jump(self, residual: float, residuals: list[float]) -> str:
-        """Why a frame's ``residual`` says the fit broke, given the tracked frames' before it
-        (finite ones, in order), or "" if it does not: it must be over ``divergence_ratio``
-        times their median (floored at ``noise_floor``) and over ``divergence_jump`` times the
-        last one's. A break is sudden; a residual that climbs over several frames is the body
-        turning sides to the cameras that the key frame does not show."""
-        if not residuals:
-            return ""
-        s = self.settings
-        median, last = float(np.median(residuals)), residuals[-1]
-        if residual <= s.divergence_ratio * max(median, s.noise_floor) or \
-                residual <= s.divergence_jump * last:
-            return ""
-        jump = f" and {s.divergence_jump:g}x the frame before's ({last:.4f})" \
-            if s.divergence_jump > 0 else ""
-        return (f"residual {residual:.4f} is over {s.divergence_ratio:g}x the median so far "
-                f"({median:.4f}){jump}")
+
+def residual_jump(residual: float, residuals: list[float], settings: TrackerSettings) -> str:
+    """Why a frame's ``residual`` says the fit broke, given the residuals of the tracked
+    frames before it (finite ones, in order), or "" if it does not: over
+    ``divergence_ratio`` times their median (floored at ``noise_floor``) and over
+    ``divergence_jump`` times the lower of the last two. A lost fit breaks within a frame or
+    two (a plate's camel slid off over two: 0.039, 0.068, 0.121); a residual that climbs
+    over more is the body turning sides to the cameras that the key frame does not show (a
+    walker turning on the spot: 0.017, 0.034, 0.038, 0.051)."""
+    if not residuals:
+        return ""
+    median, before = float(np.median(residuals)), min(residuals[-2:])
+    if residual <= settings.divergence_ratio * max(median, settings.noise_floor) or \
+            residual <= settings.divergence_jump * before:
+        return ""
+    jump = (f" and {settings.divergence_jump:g}x the lower of the two frames' before "
+            f"({before:.4f})") if settings.divergence_jump > 0 else ""
+    return (f"residual {residual:.4f} is over {settings.divergence_ratio:g}x the median so far "
+            f"({median:.4f}){jump}")
 
 
 def held_joints(prev: FrameResult, side_on: bool) -> list[str]:
