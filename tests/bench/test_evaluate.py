@@ -109,12 +109,10 @@ def test_one_views_best_fit_turns_limbs_in_the_image_plane_and_the_root_about_th
     for _, joint, _ in evaluate.LIMBS:
         sk.kinds[sk.index(joint)] = BALL
     R, p = out_of_plane[0].copy(), out_of_plane[1]
-    in_plane = R.copy()
-    for f, a in enumerate([0, 10, 20, 30, 40]):
-        in_plane[f, sk.index("LeftHip")] = se3.exp_so3([0.0, 0.0, np.radians(a)])
-    turned = R.copy()
-    for f, a in enumerate([0, 10, 20, 30, 40]):
-        turned[f, 0] = se3.exp_so3([0.0, np.radians(a), 0.0])  # about y: toward the view
+    in_plane, turned = R.copy(), R.copy()
+    for f, a in enumerate(np.radians([0, 10, 20, 30, 40])):
+        in_plane[f, sk.index("LeftHip")] = se3.exp_so3([0.0, 0.0, a])
+        turned[f, 0] = se3.exp_so3([0.0, a, 0.0])  # about y: toward the view
     view = View(se3.Similarity(150.0, np.diag([1.0, -1, -1]), np.zeros(3)), np.zeros(2))
     body = side_on_skeleton(sk, BodyPose(R[0].copy(), p[0].copy(), [view]))
     assert body is not sk
