@@ -28,6 +28,9 @@ from .skeleton import BALL, Skeleton
 
 PRIOR_ANGLE = 0.02  # weight (pixels per radian) holding unconstrained rotations at the guess
 PRIOR_LENGTH = 0.5  # weight (pixels per unit of log length) holding lengths at the guess
+PRIOR_SHIFT = 0.02  # weight (pixels per pixel the views would see it move) holding the root
+# where it was guessed along what no view sees: the line of sight of orthographic views, down
+# which the fit otherwise slid a body kilometres in one step (its Jacobian column is zero)
 
 
 class FitError(InputError):
@@ -131,12 +134,17 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
                    np.array(list(c.values()), dtype=float).reshape(-1, 2))
                   for v, c in zip(points, clicks)]
 
+    # the calibrated root's move, weighted by the pixels a unit of it spans in the views
+    shift_weight = PRIOR_SHIFT * np.mean([v.scale_at(guess.root_position)
+                                          for v in guess.views]) if mode == CALIBRATED else 0.0
+
     def residuals(x):
         R, root, offsets, views, factors = unpack(x)
         M = sk.joint_frames(R, root, offsets)
         res = [(v.project(np.einsum("nab,nb->na", M[idx, :3, :3], ref) + M[idx, :3, 3])
                 - pts).ravel() for v, (idx, ref, pts) in zip(views, clicked_at)]
-        res += [PRIOR_ANGLE * x[n_root:n_root + n_dof], PRIOR_LENGTH * x[n_root + n_dof:]]
+        res += [shift_weight * x[:3], PRIOR_ANGLE * x[n_root:n_root + n_dof],
+                PRIOR_LENGTH * x[n_root + n_dof:]]
         return np.concatenate(res)
 
     x0 = np.zeros(n_root + n_dof + n_len)

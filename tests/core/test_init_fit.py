@@ -358,6 +358,9 @@ def test_the_tips_of_limbs_pin_the_bones_that_end_in_them():
     both = fit_pose(sk, guess, [{**clicks, **tips}], CALIBRATED, fit_lengths=False)
     joints_only = fit_pose(sk, guess, [clicks], CALIBRATED, fit_lengths=False)
     assert both.residual_px < 0.05
+    # one orthographic view cannot see the body's depth: the fit leaves it where it was
+    # (its float32 copy in Blender lost pixels once it had slid kilometres away)
+    np.testing.assert_allclose(both.pose.root_position, root, atol=1e-3)
     for j in hinges:
         err = np.degrees(se3.rotation_angle_between(both.pose.rotations[j], R_true[j]))
         assert err < 0.1, sk.names[j]
