@@ -15,6 +15,7 @@ local x, y, z axes; a fixed joint keeps its initial rotation.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -374,10 +375,23 @@ def planar_chain_template(lengths=(0.5, 0.4, 0.3), axis=(0, 0, 1)) -> Skeleton:
     return _build(spec, ends)
 
 
+# degrees a planar quadruped's joints turn either way from the pose they stand in (the
+# template's, or one posed over a first frame): a head and neck nod, a leg's bones swing
+# through a gallop's stride; none folds up onto the trunk or turns the head over
+QUADRUPED_REACH = {"Neck": 45.0, "Head": 45.0, "Upper": 75.0, "Lower": 75.0}
+
+
+def quadruped_limits(names: Sequence[str]) -> dict[str, tuple[float, float]]:
+    """Hinge ranges (degrees, name -> (lowest, highest)) of ``QUADRUPED_REACH`` for those of
+    ``names`` that end in its keys: a planar quadruped's neck, head and legs."""
+    return {n: (-r, r) for n in names for k, r in QUADRUPED_REACH.items() if n.endswith(k)}
+
+
 def planar_quadruped_template() -> Skeleton:
     """A horse-like body seen from its side (+x forward, y up, z toward the camera): a rigid
     trunk from rump to chest (its joint at the rump) carrying neck and head and four
-    two-segment legs, every joint a hinge about z."""
+    two-segment legs, every joint a hinge about z within ``quadruped_limits`` of this
+    standing pose."""
     z = (0, 0, 1)
     spec = [
         ("Trunk", None, (-0.8, 1.3, 0), FIXED),
@@ -391,7 +405,7 @@ def planar_quadruped_template() -> Skeleton:
             spec += [(top, "Trunk", (x, -0.15, dz), HINGE, z),
                      (low, top, (0, -0.55, 0), HINGE, z)]
             ends += [None, (0, -0.55, 0)]
-    sk = _build(spec, ends)
+    sk = _build(spec, ends, quadruped_limits([s[0] for s in spec]))
     sk.blobs = [bone_blob(0, "Trunk", sk.rest_positions[0] - (0.05, 0, 0),
                           sk.offsets[1] + (0.1, 0, 0), (0.33, 0.25))]
     sk.blobs += [b for b in sk.default_blobs() if b.joint != 0]

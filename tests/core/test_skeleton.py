@@ -61,6 +61,13 @@ def test_templates_have_the_named_degrees_of_freedom():
     assert len(axes) == 10  # neck, head, two joints on each of four legs
     np.testing.assert_allclose(axes, np.tile([0, 0, 1.0], (10, 1)))
     assert [b.name for b in horse.blobs if b.joint == 0] == ["Trunk"]
+    # every hinge kept within its reach of the standing pose: a leg's bone 75 degrees
+    # either way, the head and neck 45
+    reach = np.degrees(horse.limits[:, 1])
+    assert reach[horse.index("LeftHindLower")] == reach[horse.index("RightForeUpper")] == 75
+    assert reach[horse.index("Head")] == reach[horse.index("Neck")] == 45
+    np.testing.assert_allclose(horse.limits[1:, 0], -horse.limits[1:, 1])
+    assert all(horse.limited_hinge(j) for j in range(1, horse.n_joints))
     for sk in (human, walker, chain, horse):
         assert sk.blobs and all(np.all(b.radii > 0) for b in sk.blobs)
 
