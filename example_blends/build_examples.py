@@ -17,8 +17,9 @@ muybridge_plates/plate_NAME_frames/); muybridge_horse.blend: "Sallie Gardner at 
 its frames already cut (muybridge_horse/). Each with the planar quadruped of bench/plates.py
 standing on the joints clicked on its first frame (bench/data/plates/NAME.json; the clicks
 are the view's markers there, so Fit Pose to Markers gives the pose back), a centimetre per
-pixel; tracked from there through the real Track operator, with a volumetric body riding on
-it. The horse's, the baboon's and the camel's strides are also made into a cycle, an action
+pixel; tracked from there through the real Track operator and the view's still camera
+(Muybridge's cameras stood in a row beside the track: the animal is as large in every cell),
+with a volumetric body riding on it. The horse's, the baboon's and the camel's strides are also made into a cycle, an action
 of its own in the file, exported as exports/NAME_cycle.bvh and .fbx; the mule bucks, which
 is no gait. Each scene's text 'About this example' says what it holds.
 
@@ -127,7 +128,7 @@ def pose_on_plate(scene, twist_addon, spec: dict, name: str):
     sk, _ = planar_body(spec, PLATE_UNIT)
     arm = twist_addon.bridge.armature_from_skeleton(sk, name.title(), scene.collection)
     scene.twist.armature = arm
-    scene.twist.mode = "INDEPENDENT"
+    scene.twist.mode = "CALIBRATED"  # the animal as large in every cell: no scale to drift
     scene.twist.tracker.side_on = True
     for bone, xy in spec["clicks"].items():
         twist_addon.markers.set_marker(view, bone, 1, *xy)
@@ -188,8 +189,9 @@ track into the action '{name} cycle', kept in this file (pick it in the Action e
 watch it loop), exported as exports/{name}_cycle.bvh and .fbx.
 """
 ABOUT_NO_CYCLE = """
-A buck is not a gait, so no cycle is made of it: the track holds the frames the tracker
-could follow, and stops where it cannot.
+A buck is not a gait, so no cycle is made of it. Its legs turn further from cell to cell
+than the tracker can follow: the frames it doubts are listed in the Results panel and marked
+on the timeline, and a run stops where the body is lost.
 """
 
 

@@ -54,14 +54,14 @@ def _cut_pose_track(bpy, registered, tmp_path, name):
 def test_a_walking_plate_is_cut_posed_and_tracked_in_blender(bpy_module, registered,
                                                              tmp_path, name, cells, gain):
     """The armature's blobs are the bones' envelopes (one radius each, the trunk's from rump
-    to neck), coarser than the benchmark's body. Measured: the baboon's first frame overlaps
-    its silhouette 0.52; frames 2-7 tracked 0.48-0.55 against the first pose carried along
-    0.41-0.48; from frame 8 on its legs drift (0.37-0.44 against 0.39-0.51), all twelve
-    frames tracked. The camel's 0.55 on the first, 0.51-0.57 tracked through all ten,
-    mean 0.53 on frames 2-8 against 0.51 carried: the outline barely tells the two apart
-    (``bench/plates.py`` scores the feet too). Asserted: at least nine frames keyed through
-    the real operators, and on frames 2-8 the tracked outline's mean beats the carried
-    pose's, by 0.02 for the baboon."""
+    to neck), coarser than the benchmark's body; tracked through the view's still camera.
+    Measured: the baboon's first frame overlaps its silhouette 0.55; frames 2-7 tracked
+    0.53-0.57 against the first pose carried along 0.45-0.51, frames 8-12 0.47-0.52 against
+    0.39-0.45, all twelve tracked. The camel's 0.55 on the first, 0.51-0.57 tracked through
+    all ten, mean 0.54 on frames 2-8 against 0.52 carried: the outline barely tells the two
+    apart (``bench/plates.py`` scores the feet too). Asserted: at least nine frames keyed
+    through the real operators, and on frames 2-8 the tracked outline's mean beats the
+    carried pose's, by 0.02 for the baboon."""
     scene, overlaps = _cut_pose_track(bpy_module, registered, tmp_path, name)
     assert (scene.frame_start, scene.frame_end) == (1, cells)
     assert len(overlaps) >= 9
@@ -73,16 +73,16 @@ def test_a_walking_plate_is_cut_posed_and_tracked_in_blender(bpy_module, registe
 def test_the_bucking_mule_is_tracked_as_far_as_it_holds_and_its_doubts_flagged(
         bpy_module, registered, tmp_path):
     """The mule rears, lands and kicks: from frame to frame its legs turn further than
-    anything the differential tracker can follow. Measured: kept frames 1-4, every one after
-    the first flagged, stopped at frame 5 (the body read as leaving the image). Asserted:
-    the run stops before the end, and no frame it kept after the first has its outline under
-    0.9 of the first frame's without being listed to check."""
+    anything the differential tracker can follow. Measured: all eight frames kept, the
+    tracked outline 0.28-0.43 against 0.52 on the first (the first pose carried along
+    0.20-0.29), every frame after the first listed to check. Asserted: the frames listed are
+    the ones marked on the timeline, and no frame kept after the first has its outline under
+    0.9 of the first frame's without being listed."""
     scene, overlaps = _cut_pose_track(bpy_module, registered, tmp_path, "mule")
     result = scene.twist.result
-    assert len(overlaps) < scene.frame_end and result.diverged_frames
     prefix = registered.twist_addon.checks.PREFIX
     marked = {m.frame for m in scene.timeline_markers if m.name.startswith(prefix)}
     assert registered.core.confidence.frame_list(marked) == result.frames_to_check
     lost = {f for f, (tracked, _) in enumerate(overlaps, 1)
             if f > 1 and tracked < 0.9 * overlaps[0, 0]}
-    assert lost <= marked, (overlaps, result.frames_to_check)
+    assert lost and lost <= marked, (overlaps, result.frames_to_check)
