@@ -19,9 +19,10 @@ standing on the joints clicked on its first frame (bench/data/plates/NAME.json; 
 are the view's markers there, so Fit Pose to Markers gives the pose back), a centimetre per
 pixel; tracked from there through the real Track operator and the view's still camera
 (Muybridge's cameras stood in a row beside the track: the animal is as large in every cell),
-with a volumetric body riding on it. The horse's, the baboon's and the camel's strides are also made into a cycle, an action
-of its own in the file, exported as exports/NAME_cycle.bvh and .fbx; the mule bucks, which
-is no gait. Each scene's text 'About this example' says what it holds.
+with a volumetric body riding on it. The horse's, the baboon's and the camel's strides are
+also made into a cycle, an action of its own in the file, exported as
+exports/NAME_cycle.bvh and .fbx; the mule bucks, which is no gait. Each scene's text 'About
+this example' says what it holds.
 
 Paths are relative to each .blend, so the folder can move.
 """
