@@ -61,7 +61,7 @@ from walk_benchmark import track_job  # noqa: E402
 from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
-from core.side_on import out_of_side_on, side_on_skeleton  # noqa: E402
+from core.side_on import line_of_sight, out_of_side_on, side_on_skeleton  # noqa: E402
 from core.skeleton import skeleton_from_bvh  # noqa: E402
 
 DATA = ROOT / "bench" / "data"
@@ -131,13 +131,14 @@ def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
                ) -> tuple[float, float]:
     """Held still and the best fit of the tracked degrees of freedom over the run's frames.
     A body tracked side-on (one view) is fitted as the tracker holds it: its depth-blind
-    joints hinges about the line of sight (``side_on_skeleton``), its root turning about
-    that line alone; so the best fit is one view's floor, not three's. The same for every
-    look whose view looks the same way, so fitted once per clip, run, starting frame and
-    line of sight."""
+    joints hinges about the line of sight (``side_on_skeleton``; a moving camera's mean,
+    ``line_of_sight``), its root turning about that line alone; so the best fit is one
+    view's floor, not three's. The same for every look whose view looks the same way, so
+    fitted once per clip, run, starting frame and line of sight."""
     sk = job.skeleton
-    body = side_on_skeleton(sk, job.initial) if job.settings.side_on else sk
-    sight = job.initial.views[0].orientation[2] if body is not sk else None
+    sight = line_of_sight(job.initial, job.moving[0] if job.moving else None)
+    body = side_on_skeleton(sk, job.initial, sight) if job.settings.side_on else sk
+    sight = sight if body is not sk else None
     key = (clip_dir, run, start, None if sight is None else tuple(np.round(sight, 3)))
     if key not in _REFERENCES:
         names = sk.tracked_joint_names()

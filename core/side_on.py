@@ -7,9 +7,12 @@ that look different ways leave the body as it is."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from . import se3
+from .camera import Camera
 from .linearize import Kinematics
 from .pose import BodyPose
 from .search import SIDE_ON
@@ -25,38 +28,60 @@ BODY, TURNED = "body", "turned"  # the flag of a frame whose body turned out of 
 FORESHORTENED = 0.2
 
 
-def depth_blind_joints(skeleton: Skeleton, pose: BodyPose) -> list[str]:
+def line_of_sight(pose: BodyPose, cameras: Sequence[Camera] | None = None) -> np.ndarray:
+    """The line (a unit world direction) side-on's hinges turn about: the first view's at
+    ``pose``, or, where that view's camera moves (``cameras``: it on every frame tracked),
+    its mean over them. A body seen by a camera panning with it has one set of hinges for
+    every frame; about the mean line each frame's own is at most half the pan off (a camera
+    panning 46 degrees with a walker: the best fit of one view 13.0 degrees about the first
+    frame's line, 5.6 about the mean, 5.5 for a still camera). A camera circling the body so far
+    that the lines' mean cosine to their mean is under a half (a steady sweep of about 220
+    degrees) has no such line; its first frame's is taken."""
+    first = pose.views[0].orientation[2]
+    if not cameras:
+        return first
+    mean = np.mean([c.orientation[2] for c in cameras], axis=0)
+    norm = np.linalg.norm(mean)  # the lines' mean cosine to it
+    return mean / norm if norm > 0.5 else first
+
+
+def depth_blind_joints(skeleton: Skeleton, pose: BodyPose,
+                       sight: np.ndarray | None = None) -> list[str]:
     """Names of the tracked joints that turn their limbs toward or away from the cameras
     when every view looks along one line (one view, or views within 15 degrees of it): the
     footage shows such a turn only as foreshortening, the same for either sign. A ball joint
     is always one; a hinge is not when its axis at ``pose`` lies within 25 degrees of the
-    line of sight (it turns in the image plane). Empty when the views look different ways."""
-    sight = [v.orientation[2] for v in pose.views]
-    if any(abs(sight[0] @ d) < ONE_LINE_OF_SIGHT for d in sight[1:]):
+    line of sight (``sight``, a world direction: the first view's at ``pose`` unless given;
+    it turns in the image plane). Empty when the views look different ways."""
+    lines = [v.orientation[2] for v in pose.views]
+    if any(abs(lines[0] @ d) < ONE_LINE_OF_SIGHT for d in lines[1:]):
         return []
+    sight = lines[0] if sight is None else sight
     frames = Kinematics(skeleton, pose).frames
     blind = []
     for name in skeleton.tracked_joint_names():
         j = skeleton.index(name)
         if (skeleton.kinds[j] != HINGE
-                or abs(sight[0] @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON):
+                or abs(sight @ frames[j, :3, :3] @ skeleton.axes[j]) < SIDE_ON):
             blind.append(name)
     return blind
 
 
-def side_on_skeleton(skeleton: Skeleton, pose: BodyPose) -> Skeleton:
+def side_on_skeleton(skeleton: Skeleton, pose: BodyPose,
+                     sight: np.ndarray | None = None) -> Skeleton:
     """``skeleton`` with every joint ``depth_blind_joints`` names at ``pose`` a hinge about
-    the line of sight there (its axis in the joint's frame, its angle 0 at ``pose``): the
-    paper's body for one camera. A limited hinge so remade keeps the image-plane angles its
-    own range reaches from ``pose`` (``image_range``): an elbow seen obliquely still does
-    not bend backward. ``skeleton`` itself when the views look different ways."""
-    blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose)]
+    the line of sight (``sight``, a unit world direction: the first view's at ``pose`` unless
+    given; its axis in the joint's frame, its angle 0 at ``pose``): the paper's body for one
+    camera. A limited hinge so remade keeps the image-plane angles its own range reaches
+    from ``pose`` (``image_range``): an elbow seen obliquely still does not bend backward.
+    ``skeleton`` itself when the views look different ways."""
+    blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose, sight)]
     if not blind:
         return skeleton
     frames = Kinematics(skeleton, pose).frames
     kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
     zero = skeleton.hinge_zero.copy()
-    sight = pose.views[0].orientation[2]
+    sight = pose.views[0].orientation[2] if sight is None else sight
     for j in blind:
         limits[j] = (image_range(skeleton, j, frames, pose.rotations[j], sight)
                      if skeleton.limited_hinge(j)
@@ -101,11 +126,13 @@ def out_of_side_on(turned: float | None) -> bool:
     return turned is not None and turned > OUT_OF_SIDE_ON_DEG
 
 
-def turned_from(key: BodyPose, pose: BodyPose) -> float:
-    """Degrees the body at ``pose`` has turned toward or away from the first view's camera
-    since ``key`` (0 for a turn about the line of sight, which the image shows; a body
-    turned half round is seen side-on again): the angle between the line of sight as the
-    root's frame sees it at the two poses, the turn's sign left out."""
-    def sight(p: BodyPose) -> np.ndarray:
-        return p.rotations[0].T @ p.views[0].orientation[2]
-    return float(np.degrees(np.arccos(np.clip(abs(sight(key) @ sight(pose)), 0.0, 1.0))))
+def turned_from(key: BodyPose, pose: BodyPose, sight: np.ndarray | None = None) -> float:
+    """Degrees the first view's line of sight at ``pose`` lies off the line the side-on
+    hinges turn about (``sight`` at ``key``, the view's own there unless given), as the
+    root's frame sees them (0 for a turn about the line of sight, which the image shows; a
+    body turned half round is seen side-on again; the turn's sign left out): how far the
+    body has turned toward or away from the camera since ``key``, and a moving camera
+    round it."""
+    hinge = key.rotations[0].T @ (key.views[0].orientation[2] if sight is None else sight)
+    now = pose.rotations[0].T @ pose.views[0].orientation[2]
+    return float(np.degrees(np.arccos(np.clip(abs(hinge @ now), 0.0, 1.0))))

@@ -32,7 +32,7 @@ from .frame_fit import FrameFit, FrameResult
 from .linearize import Kinematics
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, extrapolate
 from .settings import TrackerSettings
-from .side_on import depth_blind_joints, side_on_skeleton, turned_from
+from .side_on import depth_blind_joints, line_of_sight, side_on_skeleton, turned_from
 from .skeleton import Skeleton
 from .solver import DegenerateSystem
 
@@ -83,6 +83,10 @@ class Tracker(FrameFit):
         super().__init__(skeleton, images, mode, settings, moving, clean_plates)
         self.given_skeleton = skeleton  # as the caller gave it (``side_on`` changes joints)
         self.moving = moving
+        # set by ``track``: the line side-on's hinges turn about (a world direction) and the
+        # pose they were set up at
+        self.sight: np.ndarray | None = None
+        self._side_on_key: BodyPose | None = None
         if any(m is not None for m in self.moving) and mode != CALIBRATED:
             raise InputError("cameras that move need the calibrated mode: the body's root is "
                              "tracked in the world, each camera is where it was filmed from")
@@ -187,10 +191,13 @@ class Tracker(FrameFit):
         self.key_sets.clear()  # the key pose may differ from an earlier run's
         self._cue.reset()  # learned from it
         self.notes = []
-        blind = depth_blind_joints(self.given_skeleton, initial)
+        path = self.moving[0]
+        self.sight = line_of_sight(initial, None if path is None else [path[f] for f in frames])
+        self._side_on_key = initial  # the pose the side-on hinges were set up at
+        blind = depth_blind_joints(self.given_skeleton, initial, self.sight)
         self.hold_turn_in_depth = bool(blind) and self.settings.side_on  # tracked side-on
         if self.settings.side_on:
-            self._use(side_on_skeleton(self.given_skeleton, initial))
+            self._use(side_on_skeleton(self.given_skeleton, initial, self.sight))
             if blind:
                 self.notes.append(f"side-on: {', '.join(blind)} tracked as hinges about the "
                                   "line of sight, turning in the image plane only")
@@ -256,7 +263,7 @@ class Tracker(FrameFit):
             res.diverged, res.reason = True, why
         else:
             if self.hold_turn_in_depth:
-                res.turned = turned_from(key, res.pose)
+                res.turned = turned_from(self._side_on_key, res.pose, self.sight)
             self._learn_backdrops(res)
         return res
 

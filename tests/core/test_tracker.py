@@ -14,7 +14,14 @@ from core.pose import CALIBRATED, INDEPENDENT, BodyPose, apply_update, extrapola
 from core.scales import REFERENCE_BODY_PIXELS, view_octaves
 from core.search import paint
 from core.settings import TrackerSettings
-from core.side_on import BODY, TURNED, depth_blind_joints, side_on_skeleton, turned_from
+from core.side_on import (
+    BODY,
+    TURNED,
+    depth_blind_joints,
+    line_of_sight,
+    side_on_skeleton,
+    turned_from,
+)
 from core.skeleton import HINGE, human_template
 from core.solver import DegenerateSystem
 from core.tracker import Tracker, held_joints, residual_jump, track
@@ -543,21 +550,38 @@ def test_one_view_holds_the_bodys_turn_toward_the_camera_and_follows_its_turn_in
                 assert fr.turned < 1e-6
 
 
+def test_the_side_on_line_is_a_moving_cameras_mean_and_a_still_ones_own(body):
+    """A still view's line of sight; a panning camera's mean over the frames (a pan of 0 to
+    40 degrees: its 20-degree line); a camera circling most of the way round the body (300
+    degrees) has no mean line worth the name, and its first frame's is kept."""
+    sk, pose = body
+    side = BodyPose(pose.rotations, pose.root_position, [side_view(yaw_deg=90)])
+    np.testing.assert_allclose(line_of_sight(side), side.views[0].orientation[2])
+    pan = [side_view(yaw_deg=90 + a) for a in np.linspace(0, 40, 9)]
+    np.testing.assert_allclose(line_of_sight(side, pan),
+                               side_view(yaw_deg=110).orientation[2], atol=1e-12)
+    circling = [side_view(yaw_deg=90 + a) for a in np.linspace(0, 300, 11)]
+    np.testing.assert_allclose(line_of_sight(side, circling), side.views[0].orientation[2])
+
+
 def test_a_body_seen_side_on_from_a_camera_that_turns_round_it_is_flagged(body):
     """The body stands still while the one camera circles it, 10 degrees a frame about the
-    vertical: side-on, the body now shows its front. Each frame reports how far it turned
-    from the camera's line of sight (``turned_from``), and the frames past 25 degrees (where
-    the side-on hinges no longer turn in the image plane) are to check, the body flagged."""
+    vertical over 80 degrees: side-on, its hinges turn about the camera's mean line of sight
+    (40 degrees round), each frame reports how far its own line lies off that one
+    (``turned_from``), and the frames past 25 degrees (where the side-on hinges no longer
+    turn in the image plane) are to check, the body flagged."""
     sk, pose = body
-    cameras = [side_view(yaw_deg=90 + 10 * k) for k in range(6)]
+    cameras = [side_view(yaw_deg=90 + 10 * k) for k in range(9)]
     side = BodyPose(pose.rotations, pose.root_position, [cameras[0]])
     frames = [[render(sk, BodyPose(pose.rotations, pose.root_position, [c]), 0)
                for c in cameras]]
     settings = TrackerSettings(side_on=True, iterations=10)
-    res = track(Tracker(sk, frames, CALIBRATED, settings, [cameras]), side, list(range(6)))
+    tracker = Tracker(sk, frames, CALIBRATED, settings, [cameras])
+    res = track(tracker, side, list(range(9)))
+    np.testing.assert_allclose(tracker.sight, side_view(yaw_deg=130).orientation[2], atol=1e-9)
     turned = [fr.turned for fr in res.frames[1:]]
-    assert turned == pytest.approx([10, 20, 30, 40, 50], abs=1e-3)
-    assert [f for f, why in res.frames_to_check.items() if why.get(BODY) == TURNED] == [3, 4, 5]
+    assert turned == pytest.approx([30, 20, 10, 0, 10, 20, 30, 40], abs=0.1)
+    assert [f for f, why in res.frames_to_check.items() if why.get(BODY) == TURNED] == [1, 7, 8]
     assert res.frames[0].turned is None  # the user's pose
     views = [[render(sk, pose, c)] * 2 for c in range(3)]
     three = track(Tracker(sk, views, CALIBRATED, TrackerSettings(iterations=1)), pose, [0, 1])
