@@ -66,13 +66,13 @@ class TrackerSettings:
                                   "the full image")
     side_on: bool = _knob(True, "Where every view looks along one line (one view): track "
                           "every joint that could turn toward or away from the camera as a "
-                          "hinge about the line of sight at the first frame (a limited "
-                          "hinge keeping the image angles its range reaches), as the paper "
-                          "does with one camera, and turn the body itself only about that "
-                          "line: the limbs follow the footage in the image, and what the "
-                          "footage does not show in depth is held, not guessed (off: those "
-                          "turns are read from foreshortening alone). Views that look "
-                          "different ways are not affected")
+                          "hinge about the line of sight (a moving camera's mean over the "
+                          "frames; a limited hinge keeping the image angles its range "
+                          "reaches), as the paper does with one camera, and turn the body "
+                          "itself only about that line: the limbs follow the footage in the "
+                          "image, and what the footage does not show in depth is held, not "
+                          "guessed (off: those turns are read from foreshortening alone). "
+                          "Views that look different ways are not affected")
     limb_search: float = _knob(0.1, "Before refining a frame, turn each limb over a grid of "
                                "angles against the silhouette and keep the best turn when it "
                                "beats the prediction by this share of the limb's outline, "
