@@ -340,7 +340,7 @@ HOW = ("Each plate is tracked with the default settings, side-on in its one view
        "the nearer way, in % of the body's length (rump to snout on the first frame); on the "
        "first frame they measure the clicking itself. 'First pose carried' is the first "
        "frame's pose moved along with the tracked body (its root as tracked). The "
-       "horse's rider and the mule's buck are not modelled; the mule's run stops where it "
+       "horse's rider and the mule's buck are not modelled; a run stops where it "
        "diverges. The runs are chaotic: each plate is also tracked from its first frame's "
        "clicks nudged by up to a pixel (seven seeded draws), and the summary gives the mean "
        "and range over all eight runs; the table is the run from the clicks as clicked.")
