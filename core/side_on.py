@@ -75,13 +75,13 @@ def side_on_skeleton(skeleton: Skeleton, pose: BodyPose,
     camera. A limited hinge so remade keeps the image-plane angles its own range reaches
     from ``pose`` (``image_range``): an elbow seen obliquely still does not bend backward.
     ``skeleton`` itself when the views look different ways."""
+    sight = line_of_sight(pose) if sight is None else sight
     blind = [skeleton.index(n) for n in depth_blind_joints(skeleton, pose, sight)]
     if not blind:
         return skeleton
     frames = Kinematics(skeleton, pose).frames
     kinds, axes, limits = list(skeleton.kinds), skeleton.axes.copy(), skeleton.limits.copy()
     zero = skeleton.hinge_zero.copy()
-    sight = pose.views[0].orientation[2] if sight is None else sight
     for j in blind:
         limits[j] = (image_range(skeleton, j, frames, pose.rotations[j], sight)
                      if skeleton.limited_hinge(j)
