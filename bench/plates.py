@@ -92,8 +92,7 @@ def planar_body(spec: dict, unit: float = 1.0) -> tuple[Skeleton, BodyPose]:
     sk = Skeleton(names, [names.index(parent[n]) if parent[n] else -1 for n in names], offsets,
                   [FIXED] + [HINGE] * (len(names) - 1), np.tile([0, 0, 1.0], (len(names), 1)),
                   ends)
-    for name, reach in quadruped_limits(names).items():
-        sk.limits[names.index(name)] = np.radians(reach)
+    sk.limit_hinges(quadruped_limits(names))
     # the trunk from a little behind and below the rump to a little past the neck's base
     chest = pos["Neck"] - pos["Trunk"]
     sk.blobs = [bone_blob(0, "Trunk", pos["Trunk"] + np.array([-4, -4, 0]) * unit,

@@ -135,15 +135,17 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
                   for v, c in zip(points, clicks)]
 
     # the calibrated root's move, weighted by the pixels a unit of it spans in the views
+    # (independent views move their own roots, which their clicks pin)
     shift_weight = PRIOR_SHIFT * np.mean([v.scale_at(guess.root_position)
-                                          for v in guess.views]) if mode == CALIBRATED else 0.0
+                                          for v in guess.views])
+    held = slice(0, 3 if mode == CALIBRATED else 0)
 
     def residuals(x):
         R, root, offsets, views, factors = unpack(x)
         M = sk.joint_frames(R, root, offsets)
         res = [(v.project(np.einsum("nab,nb->na", M[idx, :3, :3], ref) + M[idx, :3, 3])
                 - pts).ravel() for v, (idx, ref, pts) in zip(views, clicked_at)]
-        res += [shift_weight * x[:3], PRIOR_ANGLE * x[n_root:n_root + n_dof],
+        res += [shift_weight * x[held], PRIOR_ANGLE * x[n_root:n_root + n_dof],
                 PRIOR_LENGTH * x[n_root + n_dof:]]
         return np.concatenate(res)
 

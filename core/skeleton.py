@@ -158,6 +158,11 @@ class Skeleton:
                 axes.append(a / np.linalg.norm(a))
         return np.array(joints, dtype=int), np.array(axes, dtype=float).reshape(-1, 3)
 
+    def limit_hinges(self, ranges_deg: dict[str, tuple[float, float]]) -> None:
+        """Set the named hinges' ranges (name -> (lowest, highest) angle, degrees)."""
+        for name, range_deg in ranges_deg.items():
+            self.limits[self.index(name)] = np.radians(range_deg)
+
     def limited_hinge(self, j: int) -> bool:
         """Whether joint j is a hinge with a finite limit on either side."""
         return self.kinds[j] == HINGE and bool(np.any(np.isfinite(self.limits[j])))
@@ -304,8 +309,7 @@ def _build(spec, end_sites=None, limits=None) -> Skeleton:
         if end_sites
         else None,
     )
-    for name, range_deg in (limits or {}).items():
-        sk.limits[names.index(name)] = np.radians(range_deg)
+    sk.limit_hinges(limits or {})
     sk.blobs = sk.default_blobs()
     return sk
 
