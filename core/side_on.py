@@ -56,7 +56,7 @@ def depth_blind_joints(skeleton: Skeleton, pose: BodyPose,
     lines = [v.orientation[2] for v in pose.views]
     if any(abs(lines[0] @ d) < ONE_LINE_OF_SIGHT for d in lines[1:]):
         return []
-    sight = lines[0] if sight is None else sight
+    sight = line_of_sight(pose) if sight is None else sight
     frames = Kinematics(skeleton, pose).frames
     blind = []
     for name in skeleton.tracked_joint_names():
@@ -133,6 +133,6 @@ def turned_from(key: BodyPose, pose: BodyPose, sight: np.ndarray | None = None) 
     body turned half round is seen side-on again; the turn's sign left out): how far the
     body has turned toward or away from the camera since ``key``, and a moving camera
     round it."""
-    hinge = key.rotations[0].T @ (key.views[0].orientation[2] if sight is None else sight)
+    hinge = key.rotations[0].T @ (line_of_sight(key) if sight is None else sight)
     now = pose.rotations[0].T @ pose.views[0].orientation[2]
     return float(np.degrees(np.arccos(np.clip(abs(hinge @ now), 0.0, 1.0))))
