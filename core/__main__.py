@@ -28,7 +28,7 @@ from pathlib import Path
 
 from .bvh import write_bvh
 from .calibration import CalibrationError, read_calibration, write_cameras
-from .confidence import frame_list
+from .confidence import begun_list, frame_list
 from .errors import InputError
 from .init_fit import FitError, fit_pose, least_certain
 from .job import JobError, load_fit, load_job
@@ -98,8 +98,8 @@ def _track(args) -> int:
     if check:
         print(f"check {len(check)} frames where a view disagrees with a limb (its pixels, or "
               f"its bone off the silhouette), no view sees it, or the body tracked side-on "
-              f"turned toward or away from the camera: {frame_list(check)} (the report names "
-              "the limbs)", file=sys.stderr)
+              f"turned toward or away from the camera: {frame_list(check)}; look first where "
+              f"the doubt begins: {begun_list(result.doubts_begun)}", file=sys.stderr)
     if result.diverged_frames:
         f = result.diverged_frames[0]
         print(f"stopped: frame {f} diverged ({result.frames[-1].reason}); correct the pose"

@@ -20,7 +20,7 @@ another body part in every view from the start reads as agreeing: the flag misse
 
 from __future__ import annotations
 
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +66,12 @@ def frame_list(frames) -> str:
         else:
             runs.append([f, f])
     return ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
+
+
+def begun_list(begun: Mapping[int, Mapping[str, str]]) -> str:
+    """Frames and the limbs whose doubt begins there as short text, in frame order:
+    ``3 LeftElbow, LeftKnee; 9 Neck``."""
+    return "; ".join(f"{f} {', '.join(begun[f])}" for f in sorted(begun))
 
 
 class Limbs:

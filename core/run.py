@@ -57,6 +57,8 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
         "cancelled": result.cancelled,
         "diverged_frames": result.diverged_frames,
         "frames_to_check": sorted(result.frames_to_check),
+        "doubts_begin": [{"frame": f, "flags": flags}
+                         for f, flags in sorted(result.doubts_begun.items())],
         "notes": result.notes,
         "seconds": seconds,
         "frames_per_second": len(tracked) / seconds if seconds > 0 else None,

@@ -51,6 +51,28 @@ def frames_to_check(results: Sequence[FrameResult]) -> dict[int, dict[str, str]]
     return {r.frame: r.flagged for r in results if r.flagged and not r.diverged}
 
 
+def newly_flagged(before: Mapping[str, str], now: Mapping[str, str]) -> dict[str, str]:
+    """The flags of ``now`` (``FrameResult.flagged``) on limbs that ``before``, the tracked
+    frame before it, did not flag."""
+    return {name: why for name, why in now.items() if name not in before}
+
+
+def doubts_begun(results: Sequence[FrameResult]) -> dict[int, dict[str, str]]:
+    """The tracked frames of a run's results, in tracking order, where a limb's flag begins,
+    and those flags (``newly_flagged``; a diverged frame, or one given by the user, flags
+    nothing). A limb in doubt stays flagged until every view that sees it agrees again
+    (``core.confidence``), so a long run of frames to check comes down to the few where
+    something first went wrong: where to look, and correct, first."""
+    out, before = {}, {}
+    for r in results:
+        now = {} if r.diverged else r.flagged
+        begun = newly_flagged(before, now)
+        if begun:
+            out[r.frame] = begun
+        before = now
+    return out
+
+
 
 @dataclass
 class TrackResult:
@@ -65,6 +87,10 @@ class TrackResult:
     @property
     def frames_to_check(self) -> dict[int, dict[str, str]]:
         return frames_to_check(self.frames)
+
+    @property
+    def doubts_begun(self) -> dict[int, dict[str, str]]:
+        return doubts_begun(self.frames)
 
 
 

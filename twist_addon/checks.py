@@ -1,7 +1,7 @@
-"""Frames to check, marked on the timeline: one marker per tracked frame where a limb is
-flagged (``core.confidence``), named for those limbs, so that the user can step through
-them with the timeline's marker jumps. Markers are told from the user's own by their name's
-prefix."""
+"""Where doubt begins, marked on the timeline: one marker per tracked frame where a limb's
+flag begins (``core.tracker.doubts_begun``), named for those limbs, so that the user can
+step through them with the timeline's marker jumps. Markers are told from the user's own by
+their name's prefix."""
 
 from __future__ import annotations
 
@@ -33,8 +33,8 @@ def unmark(scene, frames: Iterable[int] | None = None) -> int:
 
 
 def mark(scene, frame: int, flagged: dict[str, str]) -> None:
-    """Mark ``frame`` as one to check for the ``flagged`` limbs (bone -> flag), replacing an
-    earlier run's check marker there; no marker when nothing is flagged."""
+    """Mark ``frame`` as where the ``flagged`` limbs' doubt begins (bone -> flag), replacing
+    an earlier run's check marker there; no marker when nothing is flagged."""
     unmark(scene, [frame])
     if flagged:
         scene.timeline_markers.new(marker_name(flagged), frame=frame)

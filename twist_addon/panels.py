@@ -134,6 +134,9 @@ class TWIST_PT_results(_TwistPanel, bpy.types.Panel):
             for i, line in enumerate(textwrap.wrap("Check frames " + result.frames_to_check,
                                                    NOTE_WIDTH)):
                 col.label(text=line, icon="ERROR" if i == 0 else "BLANK1")
+            for line in textwrap.wrap("Look first where doubt begins: " + result.doubts_begin,
+                                      NOTE_WIDTH):
+                col.label(text=line, icon="BLANK1")
             row = layout.row(align=True)
             row.operator("screen.marker_jump", text="Previous", icon="TRIA_LEFT").next = False
             row.operator("screen.marker_jump", text="Next", icon="TRIA_RIGHT").next = True

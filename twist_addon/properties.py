@@ -110,7 +110,11 @@ class TWIST_PG_result(bpy.types.PropertyGroup):
     frames_to_check: bpy.props.StringProperty(
         name="Frames to Check", description="Tracked frames where a view disagrees with a limb "
         "(its pixels, or its bone off the silhouette), no view sees it, or the body tracked "
-        "side-on turned toward or away from the camera (marked on the timeline)")
+        "side-on turned toward or away from the camera")
+    doubts_begin: bpy.props.StringProperty(
+        name="Doubts Begin", description="Tracked frames where a limb's flag begins, with "
+        "those limbs (marked on the timeline): a limb in doubt stays flagged until it clearly "
+        "agrees again, so look, and correct, there first")
     notes: bpy.props.StringProperty(
         name="Notes", description="What the tracker noted about the last run, one note a "
         "line (a view whose backdrop moves, joints one line of sight cannot see turn)")

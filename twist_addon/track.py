@@ -11,10 +11,16 @@ from dataclasses import dataclass, field
 
 import bpy
 
-from ..core.confidence import frame_list
+from ..core.confidence import begun_list, frame_list
 from ..core.frame_fit import FrameResult
 from ..core.pose import BodyPose, world_pose
-from ..core.tracker import Tracker, frames_to_check, frames_tracked
+from ..core.tracker import (
+    Tracker,
+    doubts_begun,
+    frames_to_check,
+    frames_tracked,
+    newly_flagged,
+)
 from . import checks, keyframes
 from .armature_action import ArmatureAction
 from .bridge import (
@@ -113,19 +119,27 @@ class TrackSession:
         """Scene frames tracked with a limb flagged."""
         return [self.frames[f] for f in frames_to_check(self.tracked)]
 
+    def doubts_begun(self) -> dict[int, dict[str, str]]:
+        """Scene frames where a limb's flag begins, and those flags (``doubts_begun``)."""
+        return {self.frames[f]: flags for f, flags in doubts_begun(self.tracked).items()}
+
     def run(self, scene):
-        """Yield after each frame is tracked and keyed, and marked on the timeline when a
-        limb is flagged there (an earlier run's marker on it replaced)."""
+        """Yield after each frame is tracked and keyed, and marked on the timeline where a
+        limb's flag begins (an earlier run's marker on the frame replaced): a limb in doubt
+        stays flagged frame after frame, and a marker on each would bury the one to look
+        at."""
         sk = self.tracker.given_skeleton  # the armature's joints, whatever side-on tracks
         steps = self.tracker.iter_track(self.initial, range(len(self.frames)),
                                         self.corrections)
+        before = {}
         for res in steps:
             frame = self.frames[res.frame]
             if res.frame and not res.diverged:
                 R, root = world_pose(self.tracker.mode, self.initial.views[0], res.pose)
                 keyframes.write_pose(self.armature, sk, frame, R, root,
                                      self.user_keys.get(frame, frozenset()))
-                checks.mark(scene, frame, res.flagged)
+                checks.mark(scene, frame, newly_flagged(before, res.flagged))
+            before = {} if res.diverged else res.flagged
             self.tracked.append(res)
             yield res
 
@@ -148,8 +162,9 @@ def _summary(session: TrackSession, cancelled: bool) -> tuple[set, str]:
     check = session.frames_to_check()
     if check:
         msg += (f"; check frame{'s' * (len(check) > 1)} {frame_list(check)}: a view disagrees "
-                "with a limb (its pixels, or its bone off the silhouette) or no view sees it "
-                "(marked on the timeline)")
+                "with a limb (its pixels, or its bone off the silhouette) or no view sees it; "
+                f"look first where the doubt begins (marked on the timeline): "
+                f"{begun_list(session.doubts_begun())}")
     if diverged:
         last = session.tracked[-1]
         msg += f"; stopped at frame {diverged[0]}: {last.reason}. Pose the armature there, " \
@@ -193,6 +208,7 @@ class TWIST_OT_track(ArmatureAction, bpy.types.Operator):
             f"{self._session.frames[r.frame]} ({r.reason})" for r in tracked if r.diverged)
         result.notes = "\n".join(self._session.notes)
         result.frames_to_check = frame_list(self._session.frames_to_check())
+        result.doubts_begin = begun_list(self._session.doubts_begun())
         context.scene.frame_set(context.scene.frame_current)
         if not (cancelled or error):
             return {"FINISHED"}
@@ -271,6 +287,7 @@ class TWIST_OT_clear_track(ArmatureAction, bpy.types.Operator):
         keyframes.restore_pose(arm)
         checks.unmark(context.scene)
         context.scene.twist.result.frames_to_check = ""
+        context.scene.twist.result.doubts_begin = ""
         context.scene.frame_set(context.scene.frame_current)  # user keys decide where left
         return f"removed {n} tracked keyframes from '{arm.name}'"
 

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.results import listed_frames
 from support.views import one_view_example, projected_points
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "example_blends"
@@ -40,8 +41,8 @@ def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, fr
 
 def test_an_unposed_template_tracked_says_which_frames_to_check(bpy_module, registered):
     """The woman's template is not posed over her: Track keys the frames but warns,
-    lists them in the Results panel and marks them on the timeline; Clear Track takes its
-    markers away and leaves the user's."""
+    lists them in the Results panel and marks on the timeline where each limb's doubt
+    begins, naming the limbs; Clear Track takes its markers away and leaves the user's."""
     bpy = bpy_module
     bpy.ops.wm.open_mainfile(filepath=str(EXAMPLES / "muybridge_woman.blend"))
     scene = bpy.context.scene
@@ -52,12 +53,18 @@ def test_an_unposed_template_tracked_says_which_frames_to_check(bpy_module, regi
     assert result.frames_to_check
     checks = registered.twist_addon.checks
     ours = {m.frame: m.name for m in scene.timeline_markers if m.name.startswith(checks.PREFIX)}
-    listed = registered.core.confidence.frame_list(ours)
-    assert listed == result.frames_to_check
-    assert len(ours) >= (scene.frame_end - scene.frame_start) // 2, ours
+    begun = {int(f): limbs for f, limbs in (part.split(" ", 1)
+                                            for part in result.doubts_begin.split("; "))}
+    assert set(ours) == set(begun), (ours, begun)
+    for f, limbs in begun.items():  # the marker names the limbs whose doubt begins there
+        assert ours[f].startswith(checks.PREFIX + limbs.split(",")[0]), (ours[f], limbs)
+    to_check = listed_frames(result.frames_to_check)
+    # the limbs stay in doubt far longer than the frames marked, which are where they began
+    assert min(ours) == min(to_check) and set(ours) < to_check, (ours, to_check)
+    assert len(to_check) >= (scene.frame_end - scene.frame_start) // 2, to_check
     assert bpy.ops.twist.clear_track() == {"FINISHED"}
     assert [m.name for m in scene.timeline_markers] == ["stride"]
-    assert result.frames_to_check == ""
+    assert result.frames_to_check == result.doubts_begin == ""
 
 
 def test_a_check_marker_names_the_limbs_and_a_body_turned_out_of_side_on(registered):

@@ -150,9 +150,10 @@ def test_one_view_tracks_and_notes_the_joints_it_cannot_see_turn_in_depth(bpy_mo
     assert len(notes) == 1 and all(bone in notes[0] for bone in TRACKED)
     panel = registered.twist_addon.panels.TWIST_PT_results
     lines = [k["text"] for name, _, k in draw_panel(bpy, panel) if name == "label"]
-    check = scene.twist.result.frames_to_check
+    check, begun = scene.twist.result.frames_to_check, scene.twist.result.doubts_begin
     # wrapped into the sidebar's lines, nothing lost; the frames to check first
-    assert " ".join(lines) == (f"Check frames {check} " if check else "") + notes[0]
+    assert " ".join(lines) == (f"Check frames {check} Look first where doubt begins: {begun} "
+                               if check else "") + notes[0]
 
 
 def test_one_view_tracked_side_on_keys_turns_about_the_line_of_sight(bpy_module, registered,

@@ -15,14 +15,16 @@ from core.confidence import (
     UNSURE_FLAG,
     LimbCheck,
     Limbs,
+    begun_list,
     frame_list,
 )
+from core.frame_fit import FrameResult
 from core.linearize import Kinematics
 from core.pose import CALIBRATED, BodyPose
 from core.raycast import BlobStack
 from core.settings import TrackerSettings
 from core.skeleton import human_template
-from core.tracker import Tracker, track
+from core.tracker import Tracker, doubts_begun, frames_to_check, track
 from support.synthetic import render, side_view
 
 
@@ -186,3 +188,27 @@ def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
     ([], ""), ([4], "4"), ([3, 5, 6, 7, 8, 9, 12], "3, 5-9, 12"), ([2, 1], "1-2")])
 def test_frame_lists_join_runs(frames, text):
     assert frame_list(frames) == text
+
+
+def test_doubt_begins_where_a_limb_is_first_flagged_not_on_every_frame_it_stays_flagged():
+    """A limb in doubt stays flagged frame after frame; where its flag begins is what to look
+    at first. A frame the user gave (a correction) or that diverged flags nothing, so a flag
+    after it begins again."""
+    fine, doubt, unseen = LimbCheck(0.9, (0.9, 0.95)), LimbCheck(0.1, (0.1, 0.8)), \
+        LimbCheck(0.0, (None, None))
+
+    def frame(f, diverged=False, given=False, **limbs):
+        return FrameResult(frame=f, pose=None, residual=0.0, iterations=1, converged=True,
+                           diverged=diverged, given=given, limbs=limbs)
+
+    results = [frame(0, given=True),
+               frame(1, Arm=doubt, Leg=fine), frame(2, Arm=doubt, Leg=unseen),
+               frame(3, Arm=fine, Leg=unseen), frame(4, Arm=doubt, Leg=unseen),
+               frame(5, given=True), frame(6, Arm=doubt, Leg=fine),
+               frame(7, diverged=True, Arm=doubt, Leg=unseen)]
+    begun = doubts_begun(results)
+    assert begun == {1: {"Arm": UNSURE_FLAG}, 2: {"Leg": UNSEEN}, 4: {"Arm": UNSURE_FLAG},
+                     6: {"Arm": UNSURE_FLAG}}
+    assert set(begun) <= set(frames_to_check(results)) == {1, 2, 3, 4, 6}
+    assert begun_list(begun) == "1 Arm; 2 Leg; 4 Arm; 6 Arm"
+    assert begun_list({}) == ""

@@ -112,6 +112,8 @@ def test_command_line_tracks_and_writes_bvh_and_report(footage, tmp_path, mode):
     flagged = [fr["frame"] for fr in report["frames"] if any(
         c["flag"] for c in fr["limbs"].values())]
     assert report["frames_to_check"] == flagged
+    begun = [b["frame"] for b in report["doubts_begin"]]  # where each run of flags starts
+    assert begun[:1] == flagged[:1] and set(begun) <= set(flagged)
     assert ("check " in proc.stderr) == bool(flagged)
 
 
