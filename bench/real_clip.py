@@ -1,8 +1,8 @@
 """The real four-camera clip (Pose2Sim's demo, ``bench/data/pose2sim``) tracked as a user
 would, through its own calibration, and scored against reference 2-D landmarks.
 
-    python bench/real_clip.py [--frames N] [--starts N] [--stiff-back] [--write PATH]
-                              [--sheet PATH]
+    python bench/real_clip.py [--frames N] [--starts N] [--stiff-back] [--one-view]
+                              [--write PATH] [--sheet PATH]
 
 A human template (metres; its lower back free, as the suite's three-view runs have it) is
 fitted to the first frame's reference landmarks in all four
@@ -16,7 +16,8 @@ it calls visible), in % of the body's height in that view, left and right taken 
 that matches better (the frontal view's landmarks swap sides on about 30 frames); first and
 last five frames apart. Beside it: the fitted first pose held still, and every frame fitted
 to its own landmarks with the tracked body's proportions (the floor the landmarks' own noise
-and the template's joint centres leave).
+and the template's joint centres leave). With ``--one-view``, each camera is also tracked
+alone (a phone's one video), from the same first pose, and scored in its own image.
 Writes into ``.cache/real/``; ``make bench`` runs it after the suite (``make bench-real``
 alone), into ``docs/REAL_CLIP.md``.
 """
@@ -195,11 +196,12 @@ def fitted_each_frame(sk: Skeleton, poses: list, cams, views, mode: str, landmar
 
 
 def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
-        starts: int = 1) -> list[str]:
+        starts: int = 1, one_view: bool = False) -> list[str]:
     """Fit, track and score the clip's first ``frames`` frames, from its first frame and, with
     ``starts`` over 1, from each of the next ones too (the spread a difference must beat);
     the result as Markdown (and with ``sheet``, a contact sheet of the first, middle and
-    last frames of the run from the first frame there)."""
+    last frames of the run from the first frame there). With ``one_view``, each camera is
+    also tracked alone from the same first pose (``one_view_table``)."""
     WORK.mkdir(parents=True, exist_ok=True)
     sk = human_template(lower_back=lower_back)
     cams = read_calibration(DATA / "Calib.qca.txt")
@@ -223,16 +225,42 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
                                 axis=1) for k, r in enumerate(runs)]
         lines += ["", _spread([np.mean(e) for e in per_frame],
                               [np.mean(e[-5:]) for e in per_frame])]
+    if one_view:
+        lines += [""] + one_view_table(frames, sk, cams, landmarks, visibility, floor)
+    return lines
+
+
+def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
+                   visibility: np.ndarray, floor: list) -> list[str]:
+    """Each camera tracked alone (one view, so side-on), from the first pose fitted in all
+    four, and scored in its own image, beside that pose held still and ``floor`` (every frame
+    fitted to the four views' landmarks): a phone's one video, with the first pose right."""
+    lines = ["Each camera alone (one view, tracked side-on from the same first pose), scored "
+             "in that camera's image: mean distance to its landmarks, % of body height", "",
+             "| camera | tracked | first 5 | last 5 | first pose held still | each frame "
+             "fitted (four views) | frames to check |", "|---|---|---|---|---|---|---|"]
+    for c, cam in enumerate(cams):
+        fsk, tracked, _, _, _, rep = _track_from(0, frames, sk, cams, landmarks, visibility,
+                                                 camera=c)
+        e, still, best = (np.nanmean(errors_pct(fsk, poses, [cam], landmarks[c:c + 1],
+                                                visibility[c:c + 1]), axis=1)
+                          for poses in (tracked, [tracked[0]] * len(tracked), floor))
+        lines.append(f"| {cam.name} | {np.nanmean(e):.1f} | {np.nanmean(e[:5]):.1f} | "
+                     f"{np.nanmean(e[-5:]):.1f} | {np.nanmean(still):.1f} | "
+                     f"{np.nanmean(best):.1f} | {len(rep['frames_to_check'])} |")
     return lines
 
 
 def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
-                visibility: np.ndarray) -> tuple:
+                visibility: np.ndarray, camera: int | None = None) -> tuple:
     """The template fitted to frame ``start``'s landmarks (``core fit``) and tracked from
     there to frame ``frames`` - 1 with the default settings, in ``WORK`` (a folder of its
-    own for a later start): (the fitted body, the tracked (rotations, root) per frame, the
-    job, the fit's log, seconds tracking, the report)."""
+    own for a later start, or for ``camera``: that camera's view alone tracked): (the fitted
+    body, the tracked (rotations, root) per frame, the job, the fit's log, seconds tracking,
+    the report)."""
     work = WORK if start == 0 else WORK / f"from_{start}"
+    if camera is not None:
+        work = work / f"only_{cams[camera].name}"
     work.mkdir(exist_ok=True)
     R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal_points(cams, landmarks, start))
     write_bvh(template_bvh(sk).with_motion(R0[None], root0[None]), work / "guess.bvh")
@@ -247,7 +275,8 @@ def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarr
     fit_log = _run("fit", work / "fit.json", "--out", work / "fitted.bvh").stderr.strip()
     spec = {"skeleton": {"bvh": "fitted.bvh", "joints": joint_spec(sk)},
             "initial": {"bvh": "fitted.bvh"}, "mode": "calibrated", "frame_time": 1.0 / FPS,
-            "views": [dict(v, images=str(DATA / f"{c.name}.mp4")) for v, c in zip(views, cams)]}
+            "views": [dict(v, images=str(DATA / f"{c.name}.mp4")) for k, (v, c)
+                      in enumerate(zip(views, cams)) if camera in (None, k)]}
     (work / "job.json").write_text(json.dumps(spec, indent=1))
     job = load_job(work / "job.json")  # the fitted body, with the blobs it tracks
     job.images = [_frames(movie, start, frames) for movie in job.images]
@@ -286,8 +315,10 @@ def main(argv=None) -> int:
     ap.add_argument("--sheet", type=Path, help="a contact sheet (JPEG) to write")
     ap.add_argument("--starts", type=int, default=1,
                     help="also track from each of the next starts - 1 frames (the spread)")
+    ap.add_argument("--one-view", action="store_true",
+                    help="also track each camera alone, from the same first pose")
     args = ap.parse_args(argv)
-    lines = run(args.frames, not args.stiff_back, args.sheet, args.starts)
+    lines = run(args.frames, not args.stiff_back, args.sheet, args.starts, args.one_view)
     print("\n".join(lines))
     if args.write:
         Path(args.write).write_text("\n".join([
