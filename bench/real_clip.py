@@ -238,7 +238,8 @@ def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
     lines = ["Each camera alone (one view, tracked side-on from the same first pose), scored "
              "in that camera's image: mean distance to its landmarks, % of body height", "",
              "| camera | tracked | first 5 | last 5 | first pose held still | each frame "
-             "fitted (four views) | frames to check |", "|---|---|---|---|---|---|---|"]
+             "fitted (four views) | frames to check | doubt begins on |",
+             "|---|---|---|---|---|---|---|---|"]
     for c, cam in enumerate(cams):
         fsk, tracked, _, _, _, rep = _track_from(0, frames, sk, cams, landmarks, visibility,
                                                  camera=c)
@@ -247,7 +248,8 @@ def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
                           for poses in (tracked, [tracked[0]] * len(tracked), floor))
         lines.append(f"| {cam.name} | {np.nanmean(e):.1f} | {np.nanmean(e[:5]):.1f} | "
                      f"{np.nanmean(e[-5:]):.1f} | {np.nanmean(still):.1f} | "
-                     f"{np.nanmean(best):.1f} | {len(rep['frames_to_check'])} |")
+                     f"{np.nanmean(best):.1f} | {len(rep['frames_to_check'])} | "
+                     f"{len(rep['doubts_begin'])} |")
     return lines
 
 
@@ -378,8 +380,8 @@ def _table(e_track, e_still, e_floor, rep, fit_log, seconds, lower_back) -> list
         row("each frame fitted to its landmarks", e_floor), "",
         f"first frame's fit: {fit_log.splitlines()[0].split(' -> ')[0]}; tracked "
         f"{rep['frames_tracked']} of {rep['frames_total']} frames in {seconds:.0f} s; frames "
-        "to check: "
-        f"{len(rep['frames_to_check'])}"]
+        f"to check: {len(rep['frames_to_check'])}, doubt beginning on "
+        f"{len(rep['doubts_begin'])} of them (marked on the timeline)"]
 
 
 if __name__ == "__main__":
