@@ -51,26 +51,23 @@ def frames_to_check(results: Sequence[FrameResult]) -> dict[int, dict[str, str]]
     return {r.frame: r.flagged for r in results if r.flagged and not r.diverged}
 
 
-def newly_flagged(before: Mapping[str, str], now: Mapping[str, str]) -> dict[str, str]:
-    """The flags of ``now`` (``FrameResult.flagged``) on limbs that ``before``, the tracked
-    frame before it, did not flag."""
-    return {name: why for name, why in now.items() if name not in before}
+def newly_flagged(before: FrameResult | None, now: FrameResult) -> dict[str, str]:
+    """The flags of ``now`` (``FrameResult.flagged``) on limbs that ``before``, the result
+    tracked just before it (None for the first), did not flag: where those limbs' doubt
+    begins. A diverged frame flags nothing, and a frame given by the user has no checks."""
+    if now.diverged:
+        return {}
+    held = {} if before is None or before.diverged else before.flagged
+    return {name: why for name, why in now.flagged.items() if name not in held}
 
 
 def doubts_begun(results: Sequence[FrameResult]) -> dict[int, dict[str, str]]:
     """The tracked frames of a run's results, in tracking order, where a limb's flag begins,
-    and those flags (``newly_flagged``; a diverged frame, or one given by the user, flags
-    nothing). A limb in doubt stays flagged until every view that sees it agrees again
-    (``core.confidence``), so a long run of frames to check comes down to the few where
-    something first went wrong: where to look, and correct, first."""
-    out, before = {}, {}
-    for r in results:
-        now = {} if r.diverged else r.flagged
-        begun = newly_flagged(before, now)
-        if begun:
-            out[r.frame] = begun
-        before = now
-    return out
+    and those flags (``newly_flagged``). A limb in doubt stays flagged until every view that
+    sees it agrees again (``core.confidence``), so a long run of frames to check comes down
+    to the few where something first went wrong: where to look, and correct, first."""
+    begun = (newly_flagged(before, now) for before, now in zip([None, *results], results))
+    return {r.frame: flags for r, flags in zip(results, begun) if flags}
 
 
 

@@ -131,15 +131,14 @@ class TrackSession:
         sk = self.tracker.given_skeleton  # the armature's joints, whatever side-on tracks
         steps = self.tracker.iter_track(self.initial, range(len(self.frames)),
                                         self.corrections)
-        before = {}
         for res in steps:
             frame = self.frames[res.frame]
             if res.frame and not res.diverged:
                 R, root = world_pose(self.tracker.mode, self.initial.views[0], res.pose)
                 keyframes.write_pose(self.armature, sk, frame, R, root,
                                      self.user_keys.get(frame, frozenset()))
-                checks.mark(scene, frame, newly_flagged(before, res.flagged))
-            before = {} if res.diverged else res.flagged
+                checks.mark(scene, frame,
+                            newly_flagged(self.tracked[-1] if self.tracked else None, res))
             self.tracked.append(res)
             yield res
 
