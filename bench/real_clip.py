@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -253,32 +254,48 @@ def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
     return lines
 
 
-def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
-                visibility: np.ndarray, camera: int | None = None) -> tuple:
-    """The template fitted to frame ``start``'s landmarks (``core fit``) and tracked from
-    there to frame ``frames`` - 1 with the default settings, in ``WORK`` (a folder of its
-    own for a later start, or for ``camera``: that camera's view alone tracked): (the fitted
-    body, the tracked (rotations, root) per frame, the job, the fit's log, seconds tracking,
-    the report)."""
-    work = WORK if start == 0 else WORK / f"from_{start}"
-    if camera is not None:
-        work = work / f"only_{cams[camera].name}"
-    work.mkdir(exist_ok=True)
+def _fit_first_pose(work: Path, start: int, sk: Skeleton, cams, landmarks: np.ndarray,
+                    visibility: np.ndarray) -> str:
+    """The template fitted to frame ``start``'s landmarks in all the cameras (``core fit``),
+    written to ``work``/fitted.bvh; the fit's log."""
     R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal_points(cams, landmarks, start))
     write_bvh(template_bvh(sk).with_motion(R0[None], root0[None]), work / "guess.bvh")
-    views = [{"camera": {"calibration": str(DATA / "Calib.qca.txt"), "name": c.name}}
-             for c in cams]
     clicks = [{k: landmarks[c, start, i].tolist() for k, i in POINTS.items()
                if visibility[c, start, i] > VISIBLE} for c in range(len(cams))]
     skeleton = {"bvh": str(WORK / "template.bvh"), "joints": joint_spec(sk)}
-    fit = {"skeleton": skeleton, "initial": {"bvh": "guess.bvh"}, "views": views,
+    fit = {"skeleton": skeleton, "initial": {"bvh": "guess.bvh"}, "views": _views(cams),
            "mode": "calibrated", "clicks": clicks}
     (work / "fit.json").write_text(json.dumps(fit, indent=1))
-    fit_log = _run("fit", work / "fit.json", "--out", work / "fitted.bvh").stderr.strip()
-    spec = {"skeleton": {"bvh": "fitted.bvh", "joints": joint_spec(sk)},
-            "initial": {"bvh": "fitted.bvh"}, "mode": "calibrated", "frame_time": 1.0 / FPS,
+    return _run("fit", work / "fit.json", "--out", work / "fitted.bvh").stderr.strip()
+
+
+def _views(cams) -> list[dict]:
+    """A job's views, one per camera of the clip's calibration."""
+    return [{"camera": {"calibration": str(DATA / "Calib.qca.txt"), "name": c.name}}
+            for c in cams]
+
+
+def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
+                visibility: np.ndarray, camera: int | None = None) -> tuple:
+    """The template fitted to frame ``start``'s landmarks (``_fit_first_pose``) and tracked
+    from there to frame ``frames`` - 1 with the default settings, in ``WORK`` (a folder of
+    its own for a later start): (the fitted body, the tracked (rotations, root) per frame,
+    the job, the fit's log, seconds tracking, the report). With ``camera``, that camera's
+    view alone is tracked, in a folder of its own, from the body the run of all the cameras
+    from ``start`` fitted (so that run comes first; the log is then empty)."""
+    base = WORK if start == 0 else WORK / f"from_{start}"
+    base.mkdir(exist_ok=True)
+    work, fit_log = base, ""
+    if camera is None:
+        fit_log = _fit_first_pose(base, start, sk, cams, landmarks, visibility)
+    else:
+        work = base / f"only_{cams[camera].name}"
+        work.mkdir(exist_ok=True)
+    fitted = os.path.relpath(base / "fitted.bvh", work)
+    spec = {"skeleton": {"bvh": fitted, "joints": joint_spec(sk)},
+            "initial": {"bvh": fitted}, "mode": "calibrated", "frame_time": 1.0 / FPS,
             "views": [dict(v, images=str(DATA / f"{c.name}.mp4")) for k, (v, c)
-                      in enumerate(zip(views, cams)) if camera in (None, k)]}
+                      in enumerate(zip(_views(cams), cams)) if camera in (None, k)]}
     (work / "job.json").write_text(json.dumps(spec, indent=1))
     job = load_job(work / "job.json")  # the fitted body, with the blobs it tracks
     job.images = [_frames(movie, start, frames) for movie in job.images]
