@@ -292,10 +292,11 @@ def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarr
         work = base / f"only_{cams[camera].name}"
         work.mkdir(exist_ok=True)
     fitted = os.path.relpath(base / "fitted.bvh", work)
+    tracked = cams if camera is None else [cams[camera]]
     spec = {"skeleton": {"bvh": fitted, "joints": joint_spec(sk)},
             "initial": {"bvh": fitted}, "mode": "calibrated", "frame_time": 1.0 / FPS,
-            "views": [dict(v, images=str(DATA / f"{c.name}.mp4")) for k, (v, c)
-                      in enumerate(zip(_views(cams), cams)) if camera in (None, k)]}
+            "views": [dict(v, images=str(DATA / f"{c.name}.mp4"))
+                      for v, c in zip(_views(tracked), tracked)]}
     (work / "job.json").write_text(json.dumps(spec, indent=1))
     job = load_job(work / "job.json")  # the fitted body, with the blobs it tracks
     job.images = [_frames(movie, start, frames) for movie in job.images]
