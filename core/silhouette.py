@@ -53,13 +53,12 @@ class Backdrop:
     """One view's still backdrop and the foreground of any frame against it.
 
     It starts as the key frame with the body (its blobs' pixels, widened by a margin for the
-    blobs' own error) taken out: behind it, what most of ``frames`` (spread over the
-    footage) agree on where that is not the body (``_uncover``), elsewhere painted in from
-    around it; as frames are tracked, ``learn`` puts in what a tracked frame shows where the
-    body has moved off. (A temporal median of the whole image would keep in the backdrop a
-    body that stays in one place, walking toward an end-on camera.) ``still`` says whether
-    the backdrop holds: False when ``frames`` differ from it over far more than the body's
-    area (a moving camera, changing light)."""
+    blobs' own error) painted out from around it; as frames are tracked, ``learn`` puts in
+    what a tracked frame shows where the body has moved off. (A temporal median of the
+    footage would keep in the backdrop a body that stays in one place, walking toward an
+    end-on camera.) ``still`` says whether the backdrop holds: False when ``frames`` of the
+    footage differ from it over far more than the body's area (a moving camera, changing
+    light)."""
 
     def __init__(self, grey: np.ndarray, body: np.ndarray,
                  frames: Iterable[tuple[np.ndarray, np.ndarray | None]] = (),
@@ -76,63 +75,20 @@ class Backdrop:
         # pixels whose backdrop is only painted in
         self.unseen = np.zeros(body.shape, bool) if clean else self.widen(body)
         self.image, self.colour = grey.copy(), None if colour is None else colour.copy()
-        self.threshold = max(MIN_CONTRAST, _noise_bar(grey, ~self.unseen))
-        frames = [(np.asarray(f, np.float32), c) for f, c in frames]
-        if self.unseen.any() and reach == 0:
-            self._uncover(body, frames)
         if self.unseen.any():
             holes = self.unseen.astype(np.uint8)
-            img8 = to_uint8(self.image)
+            img8 = to_uint8(grey)
             self.image = cv2.inpaint(img8, holes, INPAINT_RADIUS,
                                      cv2.INPAINT_TELEA).astype(np.float32) / 255
-            if self.colour is not None:
-                self.colour = cv2.inpaint(self.colour, holes, INPAINT_RADIUS,
-                                          cv2.INPAINT_TELEA)
+            if colour is not None:
+                self.colour = cv2.inpaint(colour, holes, INPAINT_RADIUS, cv2.INPAINT_TELEA)
+        noise = np.abs(grey - cv2.medianBlur(grey, 3))[~self.unseen]
+        self.threshold = max(MIN_CONTRAST, 6 * 1.4826 * float(np.median(noise)))
+        frames = [(np.asarray(f, np.float32), c) for f, c in frames]
         self.chroma_noise = self._chroma_noise(frames)
         area = [np.count_nonzero(self.foreground(f, c) == FOREGROUND) for f, c in frames]
         self.still = not area or float(np.median(area)) <= STILL_AREA_RATIO * max(
             int(body.sum()), 1)
-
-    def _uncover(self, body: np.ndarray,
-                 frames: list[tuple[np.ndarray, np.ndarray | None]]) -> None:
-        """Take the backdrop behind the key frame's body (``body``) from ``frames`` (grey,
-        colour) where they agree on it: a painted-in pixel whose median over the key frame
-        and the frames holds more than half of them within the threshold shows what the
-        body uncovered, unless that median lies within the range the key frame's body
-        takes near it, in brightness and, in colour footage, in colour (a body that stays
-        where it was, or comes nearer, is what the frames agree on there: it stays painted
-        in)."""
-        ys, xs = np.nonzero(self.unseen)
-        box = np.s_[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
-        shown_in = [(f[box], None if c is None else c[box]) for f, c in frames
-                    if f.shape == self.image.shape]
-        key, on_body, seen = self.image[box], body[box].astype(bool), ~self.unseen[box]
-        stack = np.stack([key] + [f for f, _ in shown_in])
-        median = np.median(stack, axis=0)
-        agreed = 2 * np.count_nonzero(np.abs(stack - median) <= self.threshold, axis=0) \
-            > len(stack)
-        like_body = self._in_body_range(median, key, on_body, self.threshold)
-        colour = None
-        if self.colour is not None and all(c is not None for _, c in shown_in):
-            colour = np.median(np.stack([self.colour[box]] + [c for _, c in shown_in]),
-                               axis=0).astype(np.uint8)
-            for ratio, key_ratio in zip(_log_chroma(colour), _log_chroma(self.colour[box])):
-                like_body &= self._in_body_range(ratio, key_ratio, on_body,
-                                                 _noise_bar(key_ratio, seen))
-        shown = self.unseen[box] & agreed & ~like_body
-        self.image[box][shown] = median[shown]
-        if colour is not None:
-            self.colour[box][shown] = colour[shown]
-        self.unseen[box] &= ~shown
-
-    def _in_body_range(self, value: np.ndarray, key: np.ndarray, on_body: np.ndarray,
-                       bar: float) -> np.ndarray:
-        """Where ``value`` lies within ``bar`` of the range ``key`` takes on the body
-        (``on_body``) within twice the margin of each pixel."""
-        near = np.ones((4 * self.margin + 1,) * 2, np.uint8)
-        top = cv2.dilate(np.where(on_body, key, -np.inf).astype(np.float32), near)
-        bottom = cv2.erode(np.where(on_body, key, np.inf).astype(np.float32), near)
-        return (value >= bottom - bar) & (value <= top + bar)
 
     def _chroma_noise(self, frames) -> float | None:
         """The median colour distortion (``_chroma``) of frames against the backdrop over
@@ -301,20 +257,6 @@ class TurningBackdrop:
             if not unknown.any():
                 break
         return image, colour, unknown
-
-
-def _noise_bar(image: np.ndarray, where: np.ndarray) -> float:
-    """Six robust standard deviations of a float32 image's (H, W) pixel noise (its
-    difference from its 3x3 median) over the pixels ``where``; 0 where there are none."""
-    noise = np.abs(image - cv2.medianBlur(image, 3))[where]
-    return 6 * 1.4826 * float(np.median(noise)) if noise.size else 0.0
-
-
-def _log_chroma(colour: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """BGR colour (..., 3) as two log ratios, log(R/G) and log(B/G), float32: what a
-    shading's change of brightness leaves alone."""
-    c = np.asarray(colour, np.float32) + 1
-    return np.log(c[..., 2] / c[..., 1]), np.log(c[..., 0] / c[..., 1])
 
 
 def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

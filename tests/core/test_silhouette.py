@@ -103,32 +103,6 @@ def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
                                   cv2.pyrDown(fg.astype(np.float32)).shape)
 
 
-def test_the_backdrop_behind_the_key_frames_body_is_what_the_other_frames_agree_on():
-    """Frames spread over the footage show the wall where the key frame's body stood once
-    it has walked on: the backdrop is theirs there from the start, nothing painted in. A
-    body that stays, or comes nearer and grows, is what they agree on instead: as bright
-    as the key frame's body, so it stays painted in."""
-    rng = np.random.default_rng(1)
-    shape = (120, 160)
-    backdrop = cv2.GaussianBlur(rng.uniform(0, 0.3, shape).astype(np.float32), (0, 0), 2)
-    backdrop[::20] = backdrop[:, ::20] = 0.5
-
-    def frame(centre, r=18):
-        img = backdrop.copy()
-        img[_disc(shape, centre, r)] = 0.9
-        return img + rng.normal(0, 0.005, shape).astype(np.float32)
-
-    home = (80, 60)
-    under = _disc(shape, home, 18)
-    walked = [(frame((80 + dx, 60)), None) for dx in (-60, -45, 45, 60, 70)]
-    bd = Backdrop(frame(home), under, walked)
-    assert not bd.unseen[under].any()
-    assert np.mean(np.abs(bd.image - backdrop)[under] < 0.03) > 0.99
-    for stays in ([(frame(home), None)] * 5, [(frame(home, r), None) for r in (20, 22, 24, 26)]):
-        bd = Backdrop(frame(home), under, stays)
-        assert bd.unseen[under].all()
-
-
 def _sunlit(wall_colour, shape=(120, 160), seed=2, body_grey=0.2):
     """A textured wall of one colour (BGR, 0-1) with a grey body on it, frame by frame: the
     body (a disc) and its cast shadow (the wall at 0.45 of its light, a disc beside it)
@@ -200,18 +174,6 @@ def test_a_body_as_bright_as_its_wall_is_told_by_its_colour():
     assert np.mean(fg[shadow] == UNSURE) > 0.9
     bare = ~bd.widen(body | shadow | body0 | shadow0)  # the key frame's shadow lifts: unsure
     assert np.mean(fg[bare] == BACKDROP) > 0.99
-
-
-def test_the_wall_behind_a_body_as_bright_as_it_is_told_by_its_colour():
-    """Behind a grey body as bright as the tan wall, the frames that show the wall there are
-    told from a body that stays by their colour: taken into the backdrop, which then finds
-    the body's later frames as it did outside."""
-    frame = _sunlit((0.4, 0.65, 0.9), seed=4, body_grey=None)
-    (g0, c0), body0, _ = frame(0)
-    bd = Backdrop(g0, body0, [frame(k)[0] for k in (1, 2, 3)], colour=c0)
-    assert np.mean(bd.unseen[body0]) < 0.05
-    grey_only = Backdrop(g0, body0, [(f, None) for (f, _), _, _ in map(frame, (1, 2, 3))])
-    assert np.mean(grey_only.unseen[body0]) > 0.95
 
 
 def test_a_grey_scene_stored_in_colour_is_read_by_brightness():
