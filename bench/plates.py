@@ -1,6 +1,6 @@
 """Muybridge's printed plates tracked end to end and measured against the animal's outline.
 
-    python bench/plates.py [NAME ...] [--write docs/PLATES.md]
+    python bench/plates.py [NAME ...] [--settings JSON] [--write docs/PLATES.md]
 
 For each plate with clicks in ``bench/data/plates/NAME.json``: the plate is cut into its
 cells (``core.plate``), a planar quadruped is built from the joints clicked on the first
@@ -16,7 +16,7 @@ silhouette (the pixels clearly darker than the light backdrop, specks removed, t
 piece), beside the first frame's pose carried along with the tracked body (its root as
 tracked, its joints as clicked). A rider, and most tails, are not modelled, so even the
 first frame's overlap is well under 1: the measure is the tracked frames against the
-first.
+first. ``--settings`` tracks with other tracker settings (a job's ``"settings"``).
 
 Scored too against points clicked by hand on every frame (``"scored"`` in the clicks file):
 the snout and the feet that can be told apart, fore and hind. Which foot of a pair is the
@@ -52,6 +52,7 @@ from core.image import load_grey, quiet_stderr  # noqa: E402
 from core.linearize import Kinematics  # noqa: E402
 from core.plate import write_frames  # noqa: E402
 from core.pose import CALIBRATED, BodyPose  # noqa: E402
+from core.settings import TrackerSettings  # noqa: E402
 from core.skeleton import FIXED, HINGE, Skeleton, bone_blob, quadruped_limits  # noqa: E402
 from core.tracker import Tracker, track  # noqa: E402
 
@@ -214,9 +215,9 @@ def nudged(spec: dict, draw: int) -> dict:
                               for name, xy in spec["clicks"].items()})
 
 
-def run(name: str, draw: int = 0) -> list[FrameScore]:
-    """Cut, pose (from the clicks ``nudged`` by ``draw``), track and score the plate
-    ``name``."""
+def run(name: str, draw: int = 0, settings: dict | None = None) -> list[FrameScore]:
+    """Cut, pose (from the clicks ``nudged`` by ``draw``), track (with the tracker's
+    ``settings`` where not the defaults) and score the plate ``name``."""
     spec = nudged(json.loads((DATA / f"{name}.json").read_text()), draw)
     sk, first = planar_body(spec)
     with tempfile.TemporaryDirectory() as tmp:
@@ -227,7 +228,7 @@ def run(name: str, draw: int = 0) -> list[FrameScore]:
             paths = cut_frames(spec)
         with quiet_stderr():
             greys = [load_grey(p) for p in paths]
-    tracker = Tracker(sk, [greys], CALIBRATED)
+    tracker = Tracker(sk, [greys], CALIBRATED, TrackerSettings(**(settings or {})))
     result = track(tracker, first, list(range(len(greys))))
     scores = []
     for fr in result.frames:
@@ -314,12 +315,15 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("names", nargs="*", help="plates (bench/data/plates/NAME.json); all if none")
     ap.add_argument("--write", type=Path, help="also write the results as markdown here")
+    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     a = ap.parse_args(argv)
+    settings = json.loads(a.settings)
     names = a.names or sorted(p.stem for p in DATA.glob("*.json"))
     lines = [f"# Muybridge's plates\n\nWritten by `make bench-plates` (`bench/plates.py`) on "
-             f"{date.today().isoformat()}. {HOW}\n"]
+             f"{date.today().isoformat()}. {HOW}"
+             + (f" Tracker settings: `{a.settings}`." if settings else "") + "\n"]
     for name in names:
-        runs = [run(name, draw) for draw in range(DRAWS)]
+        runs = [run(name, draw, settings) for draw in range(DRAWS)]
         lines += report(name, runs[0], runs)
     text = "\n".join(lines)
     print(text)

@@ -2,7 +2,7 @@
 would, through its own calibration, and scored against reference 2-D landmarks.
 
     python bench/real_clip.py [--frames N] [--starts N] [--stiff-back] [--one-view]
-                              [--write PATH] [--sheet PATH]
+                              [--settings JSON] [--write PATH] [--sheet PATH]
 
 A human template (metres; its lower back free, as the suite's three-view runs have it) is
 fitted to the first frame's reference landmarks in all four
@@ -18,7 +18,8 @@ last five frames apart. Beside it: the fitted first pose held still, and every f
 to its own landmarks with the tracked body's proportions (the floor the landmarks' own noise
 and the template's joint centres leave). With ``--one-view``, each camera is also tracked
 alone (a phone's one video), from the same first pose, and scored in its own image.
-Writes into ``.cache/real/``; ``make bench`` runs it after the suite (``make bench-real``
+``--settings`` tracks with other tracker settings (a job's ``"settings"``), in a folder of
+its own. Writes into ``.cache/real/``; ``make bench`` runs it after the suite (``make bench-real``
 alone), into ``docs/REAL_CLIP.md``.
 """
 
@@ -197,20 +198,24 @@ def fitted_each_frame(sk: Skeleton, poses: list, cams, views, mode: str, landmar
 
 
 def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
-        starts: int = 1, one_view: bool = False) -> list[str]:
+        starts: int = 1, one_view: bool = False, settings: dict | None = None) -> list[str]:
     """Fit, track and score the clip's first ``frames`` frames, from its first frame and, with
     ``starts`` over 1, from each of the next ones too (the spread a difference must beat);
     the result as Markdown (and with ``sheet``, a contact sheet of the first, middle and
     last frames of the run from the first frame there). With ``one_view``, each camera is
-    also tracked alone from the same first pose (``one_view_table``)."""
-    WORK.mkdir(parents=True, exist_ok=True)
+    also tracked alone from the same first pose (``one_view_table``). ``settings``: the
+    tracker's settings where not the defaults (tracked in a folder of their own)."""
+    work = WORK / ("settings_" + "".join(c if c.isalnum() else "_" for c in json.dumps(
+        settings, sort_keys=True))) if settings else WORK
+    work.mkdir(parents=True, exist_ok=True)
     sk = human_template(lower_back=lower_back)
     cams = read_calibration(DATA / "Calib.qca.txt")
     lm = np.load(DATA / "mediapipe_landmarks.npz")
     landmarks, visibility = lm["xy"].astype(float), lm["visibility"]
     assert [str(n) for n in lm["names"]] == [c.name for c in cams]
-    write_bvh(template_bvh(sk), WORK / "template.bvh")
-    runs = [_track_from(k, frames, sk, cams, landmarks, visibility) for k in range(starts)]
+    write_bvh(template_bvh(sk), work / "template.bvh")
+    runs = [_track_from(work, settings or {}, k, frames, sk, cams, landmarks, visibility)
+            for k in range(starts)]
     fsk, tracked, job, fit_log, seconds, rep = runs[0]
     e_track = errors_pct(fsk, tracked, cams, landmarks, visibility)
     e_still = errors_pct(fsk, [tracked[0]] * len(tracked), cams, landmarks, visibility)
@@ -227,12 +232,13 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
         lines += ["", _spread([np.mean(e) for e in per_frame],
                               [np.mean(e[-5:]) for e in per_frame])]
     if one_view:
-        lines += [""] + one_view_table(frames, sk, cams, landmarks, visibility, floor)
+        lines += [""] + one_view_table(work, settings or {}, frames, sk, cams, landmarks,
+                                       visibility, floor)
     return lines
 
 
-def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
-                   visibility: np.ndarray, floor: list) -> list[str]:
+def one_view_table(work: Path, settings: dict, frames: int, sk: Skeleton, cams,
+                   landmarks: np.ndarray, visibility: np.ndarray, floor: list) -> list[str]:
     """Each camera tracked alone (one view, so side-on), from the first pose fitted in all
     four, and scored in its own image, beside that pose held still and ``floor`` (every frame
     fitted to the four views' landmarks): a phone's one video, with the first pose right."""
@@ -242,8 +248,8 @@ def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
              "fitted (four views) | frames to check | doubt begins on |",
              "|---|---|---|---|---|---|---|---|"]
     for c, cam in enumerate(cams):
-        fsk, tracked, _, _, _, rep = _track_from(0, frames, sk, cams, landmarks, visibility,
-                                                 camera=c)
+        fsk, tracked, _, _, _, rep = _track_from(work, settings, 0, frames, sk, cams,
+                                                 landmarks, visibility, camera=c)
         e, still, best = (np.nanmean(errors_pct(fsk, poses, [cam], landmarks[c:c + 1],
                                                 visibility[c:c + 1]), axis=1)
                           for poses in (tracked, [tracked[0]] * len(tracked), floor))
@@ -255,14 +261,14 @@ def one_view_table(frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
 
 
 def _fit_first_pose(work: Path, start: int, sk: Skeleton, cams, landmarks: np.ndarray,
-                    visibility: np.ndarray) -> str:
+                    visibility: np.ndarray, template: Path) -> str:
     """The template fitted to frame ``start``'s landmarks in all the cameras (``core fit``),
     written to ``work``/fitted.bvh; the fit's log."""
     R0, root0 = guess_pose(sk, [c.camera for c in cams], ideal_points(cams, landmarks, start))
     write_bvh(template_bvh(sk).with_motion(R0[None], root0[None]), work / "guess.bvh")
     clicks = [{k: landmarks[c, start, i].tolist() for k, i in POINTS.items()
                if visibility[c, start, i] > VISIBLE} for c in range(len(cams))]
-    skeleton = {"bvh": str(WORK / "template.bvh"), "joints": joint_spec(sk)}
+    skeleton = {"bvh": str(template), "joints": joint_spec(sk)}
     fit = {"skeleton": skeleton, "initial": {"bvh": "guess.bvh"}, "views": _views(cams),
            "mode": "calibrated", "clicks": clicks}
     (work / "fit.json").write_text(json.dumps(fit, indent=1))
@@ -275,19 +281,21 @@ def _views(cams) -> list[dict]:
             for c in cams]
 
 
-def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarray,
-                visibility: np.ndarray, camera: int | None = None) -> tuple:
+def _track_from(root: Path, settings: dict, start: int, frames: int, sk: Skeleton, cams,
+                landmarks: np.ndarray, visibility: np.ndarray, camera: int | None = None
+                ) -> tuple:
     """The template fitted to frame ``start``'s landmarks (``_fit_first_pose``) and tracked
-    from there to frame ``frames`` - 1 with the default settings, in ``WORK`` (a folder of
+    from there to frame ``frames`` - 1 with ``settings``, in ``root`` (a folder of
     its own for a later start): (the fitted body, the tracked (rotations, root) per frame,
     the job, the fit's log, seconds tracking, the report). With ``camera``, that camera's
     view alone is tracked, in a folder of its own, from the body the run of all the cameras
     from ``start`` fitted (so that run comes first; the log is then empty)."""
-    base = WORK if start == 0 else WORK / f"from_{start}"
+    base = root if start == 0 else root / f"from_{start}"
     base.mkdir(exist_ok=True)
     work, fit_log = base, ""
     if camera is None:
-        fit_log = _fit_first_pose(base, start, sk, cams, landmarks, visibility)
+        fit_log = _fit_first_pose(base, start, sk, cams, landmarks, visibility,
+                                  root / "template.bvh")
     else:
         work = base / f"only_{cams[camera].name}"
         work.mkdir(exist_ok=True)
@@ -295,6 +303,7 @@ def _track_from(start: int, frames: int, sk: Skeleton, cams, landmarks: np.ndarr
     tracked = cams if camera is None else [cams[camera]]
     spec = {"skeleton": {"bvh": fitted, "joints": joint_spec(sk)},
             "initial": {"bvh": fitted}, "mode": "calibrated", "frame_time": 1.0 / FPS,
+            "settings": settings,
             "views": [dict(v, images=str(DATA / f"{c.name}.mp4"))
                       for v, c in zip(_views(tracked), tracked)]}
     (work / "job.json").write_text(json.dumps(spec, indent=1))
@@ -337,8 +346,10 @@ def main(argv=None) -> int:
                     help="also track from each of the next starts - 1 frames (the spread)")
     ap.add_argument("--one-view", action="store_true",
                     help="also track each camera alone, from the same first pose")
+    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     args = ap.parse_args(argv)
-    lines = run(args.frames, not args.stiff_back, args.sheet, args.starts, args.one_view)
+    lines = run(args.frames, not args.stiff_back, args.sheet, args.starts, args.one_view,
+                json.loads(args.settings))
     print("\n".join(lines))
     if args.write:
         Path(args.write).write_text("\n".join([
@@ -350,7 +361,8 @@ def main(argv=None) -> int:
             "Qualisys calibration from a first pose fitted to the first frame's reference "
             "landmarks. The landmarks are MediaPipe's, not ground truth: triangulated, they "
             "reproject within 17 px (median, about 2 % of the body's height) of "
-            "themselves.", ""] + lines)
+            "themselves." + (f" Tracker settings: `{args.settings}`." if json.loads(
+                args.settings) else ""), ""] + lines)
             + "\n")
     return 0
 
