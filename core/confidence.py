@@ -10,12 +10,20 @@ nothing) lies on the body's silhouette or off it. A view *sees* the limb when at
 those pixels (scaled so that a perfect match reads 1) times the share of the bone on the
 silhouette. The limb's confidence is its worst seeing view's agreement: every view that
 sees a limb must bear it out, as every view's evidence is needed to move it. A limb no view
-sees has confidence 0 and is flagged ``unseen`` (its pose is the prediction, held); one
-whose confidence falls under ``DOUBT`` is flagged ``unsure``, and stays flagged, frame after
-frame, until its confidence is back over ``CLEAR``: a limb lost over another body part reads
-as agreeing there (its bone is on the silhouette, its pixels follow what it covers), so one
-frame's fair agreement does not show that a limb in doubt is found again. A limb over
-another body part in every view from the start reads as agreeing: the flag misses it.
+sees has confidence 0 and is ``unseen`` (its pose is the prediction, held); the tracker
+doubts one whose confidence falls under ``DOUBT`` (``unsure``), and goes on doubting it,
+frame after frame, until its confidence is back over ``CLEAR``: a limb lost over another
+body part reads as agreeing there (its bone is on the silhouette, its pixels follow what it
+covers), so one frame's fair agreement does not show that a limb in doubt is found again. A
+limb over another body part in every view from the start reads as agreeing: nothing tells.
+
+The flags the report and the add-on show are the tracker's doubts, except with one view.
+There no second view can disagree, and a limb turned toward or away from the camera, which
+one view shows only as foreshortening, reads as agreeing wherever its outline lands: the
+one view's agreement is a weaker word, so a limb is flagged under ``ONE_VIEW_FLAG``'s first
+bar and stays flagged up to its second (one view seldom finds a lost limb again, so its flag
+clears only where the view agrees all but fully). The tracker's own doubt keeps ``DOUBT``
+and ``CLEAR`` there too: it holds a doubted limb where it was, which costs more than a look.
 """
 
 from __future__ import annotations
@@ -31,8 +39,9 @@ from .raycast import BlobStack
 from .skeleton import BALL, HINGE, Skeleton
 
 MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its pixels are visible there
-DOUBT = 0.35  # a limb is flagged below this confidence
-CLEAR = 0.9  # a limb flagged on the frame before stays flagged up to this one
+DOUBT = 0.35  # the tracker doubts a limb below this confidence
+CLEAR = 0.9  # a limb doubted on the frame before stays in doubt up to this one
+ONE_VIEW_FLAG = (0.55, 0.99)  # with one view, the flag's bars as DOUBT's and CLEAR's
 AXIS_POINTS = 9  # points along each blob's long axis whose silhouette is read
 AXIS_REACH = 0.8  # of the blob's long radius, either side of its centre
 UNSEEN, UNSURE_FLAG = "unseen", "unsure"
@@ -41,19 +50,33 @@ UNSEEN, UNSURE_FLAG = "unseen", "unsure"
 @dataclass(frozen=True)
 class LimbCheck:
     """One limb on one frame: its confidence in [0, 1], per view its agreement in [0, 1]
-    (None where the view does not see it), and whether it was flagged on the frame before
-    (``doubted``)."""
+    (None where the view does not see it), and whether the tracker doubted it on the frame
+    before (``doubted``) and the report flagged it there (``was_flagged``; None: the same)."""
 
     confidence: float
     views: tuple[float | None, ...]
     doubted: bool = False
+    was_flagged: bool | None = None
+
+    @property
+    def doubt(self) -> str:
+        """The tracker's word: '' when it trusts the limb, else ``unseen`` or ``unsure``."""
+        return self._reading(self.doubted, DOUBT, CLEAR)
 
     @property
     def flag(self) -> str:
-        """'' when the limb can be trusted, else ``unseen`` or ``unsure``."""
+        """What the report and the add-on show: '' when the limb can be trusted, else
+        ``unseen`` or ``unsure`` (the tracker's doubt, but for one view's own bars)."""
+        if len(self.views) > 1:
+            return self.doubt
+        before = self.doubted if self.was_flagged is None else self.was_flagged
+        return self._reading(before, *ONE_VIEW_FLAG)
+
+    def _reading(self, before: bool, enter: float, leave: float) -> str:
+        """``unsure`` under ``enter``, or under ``leave`` where it was so ``before``."""
         if all(v is None for v in self.views):
             return UNSEEN
-        return UNSURE_FLAG if self.confidence < (CLEAR if self.doubted else DOUBT) else ""
+        return UNSURE_FLAG if self.confidence < (leave if before else enter) else ""
 
 
 def frame_list(frames) -> str:
@@ -151,14 +174,16 @@ class Limbs:
             out[:, c] = np.where(area > 0, hit / np.maximum(area, 1), np.nan)
         return out
 
-    def checks(self, per_view: Sequence[np.ndarray], doubted: Collection[str] = ()
-               ) -> dict[str, LimbCheck]:
+    def checks(self, per_view: Sequence[np.ndarray], doubted: Collection[str] = (),
+               flagged: Collection[str] | None = None) -> dict[str, LimbCheck]:
         """Each limb's check from its agreement in every view (``view_agreement``'s);
-        ``doubted``: the limbs flagged on the frame before."""
+        ``doubted`` and ``flagged``: the limbs the tracker doubted and the report flagged
+        on the frame before (None: those doubted)."""
         out = {}
         for i, name in enumerate(self.names):
             views = tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
                           for a in per_view)
             seen = [v for v in views if v is not None]
-            out[name] = LimbCheck(min(seen) if seen else 0.0, views, name in doubted)
+            out[name] = LimbCheck(min(seen) if seen else 0.0, views, name in doubted,
+                                  None if flagged is None else name in flagged)
         return out

@@ -17,7 +17,7 @@ before refining, each limb is searched over a grid of turns against the silhouet
 (``core.search``), a turn kept where every view's pixels bear it out (the earlier frame's,
 or in two views or more the key frame's), or where two or more views' backdrops show that
 the limb cannot be where it is and can be where it turned. The finished frame's limbs are
-checked against every view (``core.confidence``); a limb flagged there leaves out, on the
+checked against every view (``core.confidence``); a limb in doubt there leaves out, on the
 next frame, its pixels that the backdrop showed to be backdrop (``release_lost_limbs``).
 Sizes in pixels are meant for a body about ``REFERENCE_BODY_PIXELS`` tall; where a view
 shows it several times that, that view's pyramid gets finer levels on top, sampled as
@@ -103,6 +103,11 @@ class FrameResult:
         if out_of_side_on(self.turned):
             out[BODY] = TURNED
         return out
+
+    @property
+    def doubts(self) -> dict[str, str]:
+        """The limbs the tracker doubts on this frame and why (``LimbCheck.doubt``)."""
+        return {name: c.doubt for name, c in self.limbs.items() if c.doubt}
 
 
 
@@ -668,10 +673,12 @@ class FrameFit:
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
 
     def _limb_checks(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
-                     fgs: list | None, doubted: Collection[str]) -> dict[str, LimbCheck]:
+                     fgs: list | None, doubted: Collection[str],
+                     flagged: Collection[str] | None) -> dict[str, LimbCheck]:
         """Each limb's confidence at the finest level's pose ``kin`` (``core.confidence``):
         per view, its mapped pixels' support (1 for a perfect match) and how much of its
-        bone lies on the silhouette; ``doubted``: the limbs flagged on the frame before."""
+        bone lies on the silhouette; ``doubted`` and ``flagged``: the limbs doubted and
+        flagged on the frame before."""
         top = 1 + self.settings.outlier_density
         axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
         per_view = []
@@ -691,7 +698,7 @@ class FrameFit:
                 code = crop[px[inside, 1], px[inside, 0]]
                 on[inside] = np.where(code == sil.UNSURE, np.nan, code == sil.FOREGROUND)
             per_view.append(self._limbs.view_agreement(ps.blob, support, on))
-        return self._limbs.checks(per_view, doubted)
+        return self._limbs.checks(per_view, doubted, flagged)
 
     def _trust(self, delta: np.ndarray) -> np.ndarray:
         """The step shortened so that no joint turns more than ``max_step`` degrees: far from
@@ -742,11 +749,12 @@ class FrameFit:
         return out
 
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
-                    predicted: BodyPose, frame: int, doubted: Collection[str] = ()
-                    ) -> FrameResult:
+                    predicted: BodyPose, frame: int, doubted: Collection[str] = (),
+                    flagged: Collection[str] | None = None) -> FrameResult:
         """One frame: refine ``predicted`` against the previous frame (``prev`` on
-        ``prev_frame``) and the key frame, coarse to fine; ``doubted``: the limbs flagged on
-        the previous frame (``LimbCheck``). Raises DegenerateSystem."""
+        ``prev_frame``) and the key frame, coarse to fine; ``doubted`` and ``flagged``: the
+        limbs doubted and flagged on the previous frame (``LimbCheck``; None: those
+        doubted). Raises DegenerateSystem."""
         s = self.settings
         t0 = time.perf_counter()
         self.scale_to(key)
@@ -825,7 +833,7 @@ class FrameFit:
                         break
         result = FrameResult(frame=frame, pose=est, residual=self._residual(sets, smp, sigmas),
                              iterations=total_iters, converged=converged,
-                             limbs=self._limb_checks(kin, sets, smp, fgs, doubted),
+                             limbs=self._limb_checks(kin, sets, smp, fgs, doubted, flagged),
                              searched=searched_joints)
         left = self._left_views(smp)
         if left:

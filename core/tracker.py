@@ -274,7 +274,7 @@ class Tracker(FrameFit):
             else prev.pose.copy(), frame)
         try:
             res = self.track_frame(prev.pose, prev.frame, key, key_frame, pred, frame,
-                                   {n for n, c in prev.limbs.items() if c.flag})
+                                   set(prev.doubts), set(prev.flagged))
         except DegenerateSystem as e:
             return FrameResult(frame=frame, pose=pred, residual=float("nan"), iterations=0,
                                converged=False, diverged=True, reason=str(e))
@@ -314,12 +314,12 @@ def residual_jump(residual: float, residuals: list[float], settings: TrackerSett
 def held_joints(prev: FrameResult, side_on: bool) -> list[str]:
     """The joints the next frame predicts where they were on ``prev`` (``Tracker.predict``):
     its limbs no view saw, and those the limb search turned there on two or more views'
-    evidence; tracked ``side_on``, its limbs in doubt too. One view that disagrees with a
+    evidence; tracked ``side_on``, the limbs it doubts there too. One view that disagrees with a
     limb (most often the far one, half behind the body) has given it no speed worth carrying
     on. With views from several sides a doubted limb keeps its speed: a shank swinging at 15
     fps is often in doubt and needs it."""
     doubt = (UNSEEN, UNSURE_FLAG) if side_on else (UNSEEN,)
-    return [n for n, why in prev.flagged.items() if why in doubt] + prev.searched
+    return [n for n, why in prev.doubts.items() if why in doubt] + prev.searched
 
 
 def track(

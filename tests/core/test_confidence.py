@@ -6,11 +6,13 @@ import copy
 import numpy as np
 import pytest
 
+from core import confidence
 from core import silhouette as sil
 from core.confidence import (
     CLEAR,
     DOUBT,
     MIN_LIMB_POINTS,
+    ONE_VIEW_FLAG,
     UNSEEN,
     UNSURE_FLAG,
     LimbCheck,
@@ -148,6 +150,61 @@ def test_a_limb_in_doubt_stays_flagged_until_its_confidence_is_clear(confidence,
     CLEAR (a limb lost over the body reads fair there and is not found again by it)."""
     assert LimbCheck(confidence, (confidence, 0.95), doubted).flag == flag
     assert LimbCheck(0.0, (None, None), doubted).flag == UNSEEN
+
+
+@pytest.mark.parametrize("confidence, before, flag", [
+    (ONE_VIEW_FLAG[0] - 0.01, False, UNSURE_FLAG), (ONE_VIEW_FLAG[0] + 0.01, False, ""),
+    (ONE_VIEW_FLAG[1] - 0.01, True, UNSURE_FLAG), (ONE_VIEW_FLAG[1] + 0.01, True, "")])
+def test_one_view_flags_by_its_own_bars_and_the_tracker_doubts_by_its_own(confidence, before,
+                                                                           flag):
+    """With one view the report's flag enters and leaves at ONE_VIEW_FLAG's bars, each from
+    its own state on the frame before, while the tracker's doubt keeps DOUBT and CLEAR;
+    with two views the two are one."""
+    assert DOUBT < ONE_VIEW_FLAG[0] < ONE_VIEW_FLAG[1] and CLEAR < ONE_VIEW_FLAG[1]
+    one = LimbCheck(confidence, (confidence,), doubted=False, was_flagged=before)
+    assert one.flag == flag and one.doubt == (UNSURE_FLAG if confidence < DOUBT else "")
+    assert LimbCheck(confidence, (confidence,), doubted=before).flag == flag  # None: as doubted
+    two = LimbCheck(confidence, (confidence, 0.99), doubted=False, was_flagged=before)
+    assert two.flag == two.doubt == (UNSURE_FLAG if confidence < DOUBT else "")
+    assert LimbCheck(0.0, (None,), was_flagged=before).flag == UNSEEN
+
+
+def test_one_views_flags_follow_their_own_frame_before_and_do_not_steer_the_tracker(
+        template, monkeypatch):
+    """Tracked side-on in one view, with the near forearm gone for a frame: every frame's
+    checks know which limbs the tracker doubted and which the report flagged on the frame
+    before, apart. Flags raised to catch fair-reading limbs change what the report shows,
+    not one pose: the tracker holds what it doubts, not what is flagged for a look."""
+    sk = copy.deepcopy(template)
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                    [side_view(yaw_deg=90)])
+    limbs = _limbs(sk)
+    without = copy.deepcopy(sk)
+    without.blobs = [b for b, i in zip(sk.blobs, limbs.of_blob)
+                     if i < 0 or limbs.names[i] != "RightElbow"]
+    frames = [[render(sk if k != 1 else without, pose, 0, noise=0.01, seed=k)
+               for k in range(4)]]
+
+    def run():
+        return track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
+                     [0, 1, 2, 3]).frames
+
+    as_set = run()
+    flags_as_set = sum(len(f.flagged) for f in as_set)  # read before the bars change
+    monkeypatch.setattr(confidence, "ONE_VIEW_FLAG", (0.7, 0.99))
+    raised = run()
+    parted = 0
+    for before, now in zip(raised[1:], raised[2:]):
+        for name, check in now.limbs.items():
+            was = before.limbs[name]
+            assert check.doubted == bool(was.doubt) and check.was_flagged == bool(was.flag)
+            parted += bool(was.flag) and not was.doubt
+    assert parted > 0
+    for a, b in zip(as_set, raised):
+        np.testing.assert_array_equal(a.pose.rotations, b.pose.rotations)
+        assert {n: c.doubt for n, c in a.limbs.items()} == {
+            n: c.doubt for n, c in b.limbs.items()}
+    assert sum(len(f.flagged) for f in raised) > flags_as_set
 
 
 def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
