@@ -83,7 +83,7 @@ class TrackerSettings:
                                "and each scores the turn better by this share, or two or more "
                                "see it off the body and on the body turned (0: off). "
                                "Catches limbs faster than a blob's width a frame")
-    release_lost_limbs: bool = _knob(True, "A limb flagged on the frame before leaves out "
+    release_lost_limbs: bool = _knob(True, "A limb in doubt on the frame before leaves out "
                                      "its pixels of that frame that the view's still "
                                      "backdrop shows were backdrop: a limb lost onto a "
                                      "textured backdrop is otherwise held there by the "
