@@ -179,27 +179,36 @@ def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, in
     return caught, bad, flagged
 
 
+def tracked_and_true(job_path: Path, run: str, start: int = 0) -> tuple:
+    """A tracked job's (``score_run``'s) job, the limbs it is scored on, and the tracked and
+    the true (rotations, root) on the run's frames; a run that stopped keeps its last pose,
+    as the keys would hold it."""
+    _, step, _ = RUNS[run]
+    job = load_job(job_path)
+    limbs = Parts.of(job.skeleton.names).limbs()
+    R, p = read_bvh(job_path.parent / "truth.bvh").poses()
+    truth = (R[start::step], p[start::step])
+    est = read_bvh(job_path.with_suffix(".bvh")).poses()
+    n = len(truth[0])
+    if len(est[0]) < n:
+        pad = n - len(est[0])
+        est = (np.concatenate([est[0], np.repeat(est[0][-1:], pad, 0)]),
+               np.concatenate([est[1], np.repeat(est[1][-1:], pad, 0)]))
+    return job, limbs, est, truth
+
+
 def score_run(job_path: Path, run: str, start: int = 0) -> dict:
     """Track one job (of ``write_job``, from ``start``) and score it beside the references
     of its clip and run."""
-    views, step, _ = RUNS[run]
+    views = RUNS[run][0]
     out = job_path.with_suffix(".bvh")
     rep_path = job_path.with_suffix(".report.json")
     code, peak_mb = track_job(job_path, out, rep_path)
     if code not in (0, 3):
         raise SystemExit(f"{job_path.name}: the tracker failed (exit {code})")
     rep = json.loads(rep_path.read_text())
-    job = load_job(job_path)
-    sk = job.skeleton
-    limbs = Parts.of(sk.names).limbs()
-    R, p = read_bvh(job_path.parent / "truth.bvh").poses()
-    truth = (R[start::step], p[start::step])
-    est = read_bvh(out).poses()
-    n = len(truth[0])
-    if len(est[0]) < n:  # stopped early: the last pose is kept, as the keys would hold it
-        pad = n - len(est[0])
-        est = (np.concatenate([est[0], np.repeat(est[0][-1:], pad, 0)]),
-               np.concatenate([est[1], np.repeat(est[1][-1:], pad, 0)]))
+    job, limbs, est, truth = tracked_and_true(job_path, run, start)
+    sk, n = job.skeleton, len(truth[0])
     tracker = evaluate.score(sk, sk.tracked_joint_names(), est, truth, limbs=limbs)
     still, best = references(job_path.parent, run, start, job, truth, limbs)
     row = {"tracker": tracker.limb_mean_deg, "still": still, "best": best,

@@ -73,10 +73,16 @@ class LimbCheck:
         return self._reading(before, *ONE_VIEW_FLAG)
 
     def _reading(self, before: bool, enter: float, leave: float) -> str:
-        """``unsure`` under ``enter``, or under ``leave`` where it was so ``before``."""
-        if all(v is None for v in self.views):
-            return UNSEEN
-        return UNSURE_FLAG if self.confidence < (leave if before else enter) else ""
+        return reading(self.confidence, any(v is not None for v in self.views), before,
+                       enter, leave)
+
+
+def reading(confidence: float, seen: bool, before: bool, enter: float, leave: float) -> str:
+    """A limb's word at bars ``enter`` and ``leave``: ``unseen`` where no view ``seen`` it,
+    else ``unsure`` under ``enter``, or under ``leave`` where it was flagged ``before``."""
+    if not seen:
+        return UNSEEN
+    return UNSURE_FLAG if confidence < (leave if before else enter) else ""
 
 
 def frame_list(frames) -> str:

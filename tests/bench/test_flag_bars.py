@@ -1,0 +1,67 @@
+"""One view's flags read again from a report: the tracker's own flags given back at the bars
+in use, and each limb's flag carried from frame to frame as the tracker carries it."""
+
+import copy
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from core.confidence import ONE_VIEW_FLAG, UNSEEN, UNSURE_FLAG, Limbs
+from core.pose import CALIBRATED, BodyPose
+from core.raycast import BlobStack
+from core.settings import TrackerSettings
+from core.skeleton import human_template
+from core.tracker import Tracker, track
+from support.synthetic import render, side_view
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "bench"))
+
+from flag_bars import reflagged  # noqa: E402
+
+
+def _report(frames) -> dict:
+    """The report's frames (``core.run.report``'s ``frames``) of tracked results, its
+    confidences unrounded."""
+    return {"frames": [{"limbs": {n: {"confidence": c.confidence, "views": list(c.views),
+                                      "flag": c.flag} for n, c in fr.limbs.items()}}
+                       for fr in frames]}
+
+
+def test_read_again_at_the_bars_in_use_a_one_view_report_gives_the_trackers_flags_back():
+    """Side-on in one view, the near forearm gone on one frame: every limb's flag read again
+    from the report at ``ONE_VIEW_FLAG`` is the tracker's, and bars that never flag leave
+    only the limbs no view sees."""
+    sk = human_template()
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                    [side_view(yaw_deg=90)])
+    limbs = Limbs(sk, BlobStack.of(sk.blobs))
+    without = copy.deepcopy(sk)
+    without.blobs = [b for b, i in zip(sk.blobs, limbs.of_blob)
+                     if i < 0 or limbs.names[i] != "RightElbow"]
+    frames = [[render(sk if k != 1 else without, pose, 0, noise=0.01, seed=k)
+               for k in range(4)]]
+    result = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
+                   [0, 1, 2, 3])
+    rep = _report(result.frames)
+    again = reflagged(rep, *ONE_VIEW_FLAG)
+    assert again == rep
+    assert any(c["flag"] == UNSURE_FLAG for fr in rep["frames"] for c in fr["limbs"].values())
+    never = reflagged(rep, 0.0, 0.0)
+    assert {c["flag"] for fr in never["frames"] for c in fr["limbs"].values()} <= {"", UNSEEN}
+
+
+def test_a_flag_is_carried_to_the_next_frame_and_a_given_frame_starts_afresh():
+    def frame(conf):
+        return {"limbs": {} if conf is None else {
+            "Arm": {"confidence": conf, "views": [conf], "flag": "?"},
+            "Leg": {"confidence": 0.0, "views": [None], "flag": "?"}}}
+
+    rep = {"frames": [frame(None), frame(0.3), frame(0.9), frame(0.95), frame(None),
+                      frame(0.9)]}
+    got = reflagged(rep, 0.5, 0.93)
+    arm = [fr["limbs"].get("Arm", {}).get("flag") for fr in got["frames"]]
+    assert arm == [None, UNSURE_FLAG, UNSURE_FLAG, "", None, ""]
+    assert all(fr["limbs"]["Leg"]["flag"] == UNSEEN for fr in got["frames"] if fr["limbs"])
+    assert rep["frames"][1]["limbs"]["Arm"]["flag"] == "?"  # the report itself is kept
