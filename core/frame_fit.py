@@ -110,7 +110,6 @@ class FrameResult:
         return {name: c.doubt for name, c in self.limbs.items() if c.doubt}
 
 
-
 @dataclass
 class PointSet:
     """Body pixels of earlier frames in one view, ready to be mapped to the new frame: one
