@@ -41,6 +41,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
+from suite import slug  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import BvhFile, BvhJoint, read_bvh, write_bvh  # noqa: E402
@@ -205,8 +206,8 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
     last frames of the run from the first frame there). With ``one_view``, each camera is
     also tracked alone from the same first pose (``one_view_table``). ``settings``: the
     tracker's settings where not the defaults (tracked in a folder of their own)."""
-    work = WORK / ("settings_" + "".join(c if c.isalnum() else "_" for c in json.dumps(
-        settings, sort_keys=True))) if settings else WORK
+    settings = settings or {}
+    work = WORK / f"settings_{slug(json.dumps(settings, sort_keys=True))}" if settings else WORK
     work.mkdir(parents=True, exist_ok=True)
     sk = human_template(lower_back=lower_back)
     cams = read_calibration(DATA / "Calib.qca.txt")
@@ -214,7 +215,7 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
     landmarks, visibility = lm["xy"].astype(float), lm["visibility"]
     assert [str(n) for n in lm["names"]] == [c.name for c in cams]
     write_bvh(template_bvh(sk), work / "template.bvh")
-    runs = [_track_from(work, settings or {}, k, frames, sk, cams, landmarks, visibility)
+    runs = [_track_from(work, settings, k, frames, sk, cams, landmarks, visibility)
             for k in range(starts)]
     fsk, tracked, job, fit_log, seconds, rep = runs[0]
     e_track = errors_pct(fsk, tracked, cams, landmarks, visibility)
@@ -232,7 +233,7 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
         lines += ["", _spread([np.mean(e) for e in per_frame],
                               [np.mean(e[-5:]) for e in per_frame])]
     if one_view:
-        lines += [""] + one_view_table(work, settings or {}, frames, sk, cams, landmarks,
+        lines += [""] + one_view_table(work, settings, frames, sk, cams, landmarks,
                                        visibility, floor)
     return lines
 
