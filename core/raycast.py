@@ -115,6 +115,16 @@ def blob_boxes(view: Camera, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray) 
     return _boxes(view, _to_unit(blobs, Rs), C)
 
 
+def outline_areas(view: Camera, blobs: list[Ellipsoid] | BlobStack, g: np.ndarray
+                  ) -> np.ndarray:
+    """Area (E,) in square pixels of every blob's whole outline, hidden or not: the ellipse
+    (p - c)^T P (p - c) <= 1 has area pi / sqrt(det P)."""
+    blobs = BlobStack.of(blobs)
+    Rs, C = _posed(blobs, g)
+    _, P = view.ellipses(_to_unit(blobs, Rs), C)
+    return np.pi / np.sqrt(P[:, 0, 0] * P[:, 1, 1] - P[:, 0, 1] * P[:, 1, 0])
+
+
 def _boxes(view: Camera, A: np.ndarray, C: np.ndarray) -> np.ndarray:
     """``blob_boxes`` of blobs with world-to-normalised maps A and world centres C: the
     outline (p - c)^T P (p - c) <= 1 reaches sqrt of P^-1's diagonal from its centre."""
@@ -162,6 +172,18 @@ class LabelGrid:
         out = np.full((-(-shape[0] // self.step), -(-shape[1] // self.step)), -1, np.int32)
         i, j = self._at
         out[i:i + self.label.shape[0], j:j + self.label.shape[1]] = self.label
+        return out
+
+    def window(self, x0: int, y0: int, shape: tuple[int, int]) -> np.ndarray:
+        """The labels of ``full``'s map on its cells (y0 .. y0 + h, x0 .. x0 + w), -1 where no
+        blob shows; ``shape`` is (h, w)."""
+        out = np.full(shape, -1, np.int32)
+        i, j = self._at
+        h, w = self.label.shape
+        r0, r1 = max(i, y0), min(i + h, y0 + shape[0])
+        c0, c1 = max(j, x0), min(j + w, x0 + shape[1])
+        if r1 > r0 and c1 > c0:
+            out[r0 - y0:r1 - y0, c0 - x0:c1 - x0] = self.label[r0 - i:r1 - i, c0 - j:c1 - j]
         return out
 
     def hits_on_full(self, rows: np.ndarray, cols: np.ndarray) -> Hits:

@@ -92,6 +92,34 @@ def test_a_label_grids_image_map_and_its_hits_there_match_casting_every_pixel(ca
 
 
 @CAMERAS
+def test_a_windows_labels_are_the_full_maps_there_and_none_beyond(camera):
+    """``LabelGrid.window`` reads ``full``'s map on any window of its cells, one reaching
+    past the map's edges included (-1 there)."""
+    sk, g = _posed(4)
+    shape = (350, 310)
+    grid = raycast.label_grid(camera(yaw_deg=30), sk.blobs, g, shape, 2)
+    full = grid.full(shape)
+    padded = np.pad(full, 60, constant_values=-1)
+    for x0, y0, h, w in ((0, 0, 175, 155), (30, 50, 60, 40), (-20, -10, 90, 200),
+                         (140, 160, 40, 40), (200, 10, 5, 5)):
+        np.testing.assert_array_equal(grid.window(x0, y0, (h, w)),
+                                      padded[y0 + 60:y0 + 60 + h, x0 + 60:x0 + 60 + w])
+
+
+@CAMERAS
+def test_outline_areas_are_the_pixels_each_blob_alone_covers(camera):
+    """``outline_areas`` (pi / sqrt(det P)) against counting the pixels each blob, cast on
+    its own, covers: equal within the pixel grid's error along the outline."""
+    sk, g = _posed(5)
+    view = camera(yaw_deg=40)
+    areas = raycast.outline_areas(view, sk.blobs, g)
+    for e, blob in enumerate(sk.blobs):
+        pix, _, _ = raycast.render_labels(view, [blob], g, (360, 320))
+        if areas[e] > 150:  # well inside the image (the arms and legs may leave it)
+            assert len(pix) == pytest.approx(areas[e], rel=0.08), blob.name
+
+
+@CAMERAS
 def test_hit_points_lie_on_their_blob_surface(camera):
     sk, g = _posed(7)
     view = camera(yaw_deg=10)
