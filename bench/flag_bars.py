@@ -2,17 +2,20 @@
 
     python bench/flag_bars.py [--runs "1 lateral view 15 fps,..."] [--clips NAME,...]
                               [--enter 0.35,0.45,...] [--clear 0.9,0.95,0.99]
+                              [--weight W]
 
 The flags do not steer the tracker with one view (``core.confidence``): the report's
 confidences are what the flags are read from, so the suite's one-view runs need not be
 tracked again to see other bars. For every report ``bench/suite.py`` left in ``.cache/suite``
 for the runs (every clip, look and start, or the ``--clips`` named), each one-view limb's flag
-is read again at each pair of bars (``confidence.reading``, each limb's flag on the frame
-before carried on), and scored as the suite scores flags (``suite.flag_counts``): % of the
-limbs over ``suite.BAD_LIMB_DEG`` off that are flagged / % of the flags on such limbs. The
-reports keep confidences to three places, so a count can differ from the suite's by the few
-limb-frames that lie on a bar. ``core.confidence.ONE_VIEW_FLAG`` was chosen this way on the
-CMU clips (``docs/RESEARCH.md``).
+is read again at each pair of bars from its confidence over one plus ``--weight`` times its
+unexplained foreground (``LimbCheck.flag_confidence``; ``confidence.reading``, each limb's
+flag on the frame before carried on), and scored as the suite scores flags
+(``suite.flag_counts``): % of the limbs over ``suite.BAD_LIMB_DEG`` off that are flagged / %
+of the flags on such limbs. The reports keep confidences to three places, so a count can
+differ from the suite's by the few limb-frames that lie on a bar.
+``core.confidence.UNEXPLAINED_WEIGHT`` was chosen this way on the CMU clips, at the tracker's
+own bars (``docs/RESEARCH.md``).
 """
 
 from __future__ import annotations
@@ -29,13 +32,15 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 from suite import CACHE, RUNS, flag_counts, slug, tracked_and_true  # noqa: E402
 
-from core.confidence import ONE_VIEW_FLAG, reading  # noqa: E402
+from core.confidence import CLEAR, DOUBT, UNEXPLAINED_WEIGHT, reading  # noqa: E402
 
 
-def reflagged(rep: dict, enter: float, clear: float) -> dict:
+def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED_WEIGHT
+              ) -> dict:
     """A copy of a one-view report (``python -m core track --report``) with every limb's flag
-    read at bars ``enter`` and ``clear``, frame after frame in order; a frame without checks
-    (one the user gave) starts every limb afresh."""
+    read at bars ``enter`` and ``clear`` (from its confidence over one plus its unexplained
+    foreground, ``LimbCheck.flag_confidence``), frame after frame in order; a frame without
+    checks (one the user gave) starts every limb afresh."""
     out = copy.deepcopy(rep)
     before: dict[str, bool] = {}
     for fr in out["frames"]:
@@ -43,8 +48,8 @@ def reflagged(rep: dict, enter: float, clear: float) -> dict:
             before = {}
         for name, check in fr["limbs"].items():
             seen = any(v is not None for v in check["views"])
-            check["flag"] = reading(check["confidence"], seen, before.get(name, False),
-                                    enter, clear)
+            confidence = check["confidence"] / (1.0 + weight * check.get("unexplained", 0.0))
+            check["flag"] = reading(confidence, seen, before.get(name, False), enter, clear)
             before[name] = bool(check["flag"])
     return out
 
@@ -62,24 +67,27 @@ def run_reports(run: str, clips: list[str] | None = None) -> list[tuple[Path, in
 
 
 def bar_table(run: str, jobs: list[tuple[Path, int]], enters: list[float],
-              clears: list[float]) -> list[str]:
-    """Caught / right (%) per pair of bars over ``jobs``, as Markdown: a row per enter bar,
-    a column per clear bar; the bars in use starred."""
+              clears: list[float], weight: float = UNEXPLAINED_WEIGHT) -> list[str]:
+    """Caught / right (%) per pair of bars over ``jobs`` at the unexplained foreground's
+    ``weight``, as Markdown: a row per enter bar, a column per clear bar; the bars in use
+    starred."""
     sums = {(e, c): [0, 0, 0] for e in enters for c in clears}
     for job, start in jobs:
         rep = json.loads(job.with_suffix(".report.json").read_text())
         tracked, limbs, est, truth = tracked_and_true(job, run, start)
         for (e, c), total in sums.items():
-            counts = flag_counts(reflagged(rep, e, c), tracked.skeleton, est, truth, limbs)
+            counts = flag_counts(reflagged(rep, e, c, weight), tracked.skeleton, est, truth,
+                                 limbs)
             total[:] = [a + b for a, b in zip(total, counts)]
-    lines = [f"{run}, {len(jobs)} runs: % of limbs far off flagged / % of flags right", "",
+    lines = [f"{run}, {len(jobs)} runs, unexplained foreground weighed {weight:g}: % of limbs "
+             "far off flagged / % of flags right", "",
              "| enter \\ clear | " + " | ".join(f"{c:g}" for c in clears) + " |",
              "|---" * (len(clears) + 1) + "|"]
     for e in enters:
         cells = []
         for c in clears:
             caught, bad, flagged = sums[e, c]
-            star = "*" if (e, c) == ONE_VIEW_FLAG else ""
+            star = "*" if (e, c) == (DOUBT, CLEAR) else ""
             cells.append(f"{star}{100 * caught / max(bad, 1):.0f} / "
                          f"{100 * caught / max(flagged, 1):.0f}{star}")
         lines.append(f"| {e:g} | " + " | ".join(cells) + " |")
@@ -93,6 +101,8 @@ def main(argv=None) -> int:
     ap.add_argument("--clips", help="comma-separated clip names (default: every one tracked)")
     ap.add_argument("--enter", default="0.35,0.45,0.5,0.55,0.6,0.65")
     ap.add_argument("--clear", default="0.9,0.95,0.99")
+    ap.add_argument("--weight", type=float, default=UNEXPLAINED_WEIGHT,
+                    help="the unexplained foreground's weight in the flag's confidence")
     a = ap.parse_args(argv)
     enters = [float(x) for x in a.enter.split(",")]
     clears = [float(x) for x in a.clear.split(",")]
@@ -102,7 +112,7 @@ def main(argv=None) -> int:
         jobs = run_reports(run, a.clips.split(",") if a.clips else None)
         if not jobs:
             raise SystemExit(f"{run}: no tracked reports in {CACHE} (run bench/suite.py)")
-        print("\n".join(bar_table(run, jobs, enters, clears)) + "\n")
+        print("\n".join(bar_table(run, jobs, enters, clears, a.weight)) + "\n")
     return 0
 
 

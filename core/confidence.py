@@ -19,11 +19,16 @@ limb over another body part in every view from the start reads as agreeing: noth
 
 The flags the report and the add-on show are the tracker's doubts, except with one view.
 There no second view can disagree, and a limb turned toward or away from the camera, which
-one view shows only as foreshortening, reads as agreeing wherever its outline lands: the
-one view's agreement is a weaker word, so a limb is flagged under ``ONE_VIEW_FLAG``'s first
-bar and stays flagged up to its second (one view seldom finds a lost limb again, so its flag
-clears only where the view agrees all but fully). The tracker's own doubt keeps ``DOUBT``
-and ``CLEAR`` there too: it holds a doubted limb where it was, which costs more than a look.
+one view shows only as foreshortening, reads as agreeing wherever its outline lands. What
+the view does show is the limb's own pixels where the track left them: foreground that no
+blob explains, beside the limb (``Limbs.unexplained``: within ``UNEXPLAINED_REACH`` of its
+length from its joint, past ``UNEXPLAINED_GAP`` of the blobs' outline, in units of the
+limb's own outline's area). So with one view the flag reads, at the tracker's own bars, the
+confidence divided by one plus ``UNEXPLAINED_WEIGHT`` times that
+(``LimbCheck.flag_confidence``), each from its own frame before. Hands, feet and hair have
+no blob and add a little near the forearms, shanks and neck on every frame alike. The
+tracker's own doubt reads the plain confidence there too: it holds a doubted limb where it
+was, which costs more than a look.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from .camera import Camera
@@ -41,40 +47,53 @@ from .skeleton import BALL, HINGE, Skeleton
 MIN_LIMB_POINTS = 10  # a view sees a limb when this many of its pixels are visible there
 DOUBT = 0.35  # the tracker doubts a limb below this confidence
 CLEAR = 0.9  # a limb doubted on the frame before stays in doubt up to this one
-ONE_VIEW_FLAG = (0.55, 0.99)  # with one view, the flag's bars as DOUBT's and CLEAR's
 AXIS_POINTS = 9  # points along each blob's long axis whose silhouette is read
 AXIS_REACH = 0.8  # of the blob's long radius, either side of its centre
+UNEXPLAINED_REACH = 1.2  # limb lengths from its joint: where a view's unexplained foreground
+# counts against the limb
+UNEXPLAINED_GAP = 2.5  # map cells: foreground this near the blobs' outline is its own slack
+UNEXPLAINED_WEIGHT = 0.85  # with one view, the flag's discount per limb area unexplained
 UNSEEN, UNSURE_FLAG = "unseen", "unsure"
 
 
 @dataclass(frozen=True)
 class LimbCheck:
     """One limb on one frame: its confidence in [0, 1], per view its agreement in [0, 1]
-    (None where the view does not see it), and whether the tracker doubted it on the frame
-    before (``doubted``) and the report flagged it there (``was_flagged``; None: the same)."""
+    (None where the view does not see it), whether the tracker doubted it on the frame
+    before (``doubted``) and the report flagged it there (``was_flagged``; None: the same),
+    and with one view the foreground no blob explains near it (``Limbs.unexplained``)."""
 
     confidence: float
     views: tuple[float | None, ...]
     doubted: bool = False
     was_flagged: bool | None = None
+    unexplained: float = 0.0
 
     @property
     def doubt(self) -> str:
         """The tracker's word: '' when it trusts the limb, else ``unseen`` or ``unsure``."""
-        return self._reading(self.doubted, DOUBT, CLEAR)
+        return self._reading(self.doubted, self.confidence)
 
     @property
     def flag(self) -> str:
         """What the report and the add-on show: '' when the limb can be trusted, else
-        ``unseen`` or ``unsure`` (the tracker's doubt, but for one view's own bars)."""
+        ``unseen`` or ``unsure`` (the tracker's doubt, but with one view the reading of
+        ``flag_confidence``)."""
         if len(self.views) > 1:
             return self.doubt
         before = self.doubted if self.was_flagged is None else self.was_flagged
-        return self._reading(before, *ONE_VIEW_FLAG)
+        return self._reading(before, self.flag_confidence)
 
-    def _reading(self, before: bool, enter: float, leave: float) -> str:
-        return reading(self.confidence, any(v is not None for v in self.views), before,
-                       enter, leave)
+    @property
+    def flag_confidence(self) -> float:
+        """The confidence the one-view flag reads: divided by one plus ``UNEXPLAINED_WEIGHT``
+        times the foreground no blob explains near the limb, in units of its own outline's
+        area."""
+        return self.confidence / (1.0 + UNEXPLAINED_WEIGHT * self.unexplained)
+
+    def _reading(self, before: bool, confidence: float) -> str:
+        return reading(confidence, any(v is not None for v in self.views), before, DOUBT,
+                       CLEAR)
 
 
 def reading(confidence: float, seen: bool, before: bool, enter: float, leave: float) -> str:
@@ -119,6 +138,8 @@ class Limbs:
                 owner[b] = max(above, key=lambda j: depth[j])
         joints = sorted(set(owner[owner >= 0].tolist()))
         self.names = [skeleton.names[j] for j in joints]
+        self.joint = np.array(joints, dtype=int)
+        self.joint_ref = skeleton.rest_positions[self.joint].reshape(-1, 3)
         index = {j: i for i, j in enumerate(joints)}
         self.of_blob = np.array([index.get(int(j), -1) for j in owner], dtype=int)
         # points along each limb blob's longest axis, in its segment's frame: where the
@@ -157,6 +178,38 @@ class Limbs:
             agree *= np.where(area > 0, hit / np.maximum(area, 1), 1.0)
         return agree
 
+    def unexplained(self, kin: Kinematics, view: Camera, grid: int, foreground: np.ndarray,
+                    at: tuple[int, int], labels: np.ndarray, areas: np.ndarray) -> np.ndarray:
+        """(L,): per limb, one view's foreground that no blob explains near it, in units of
+        the limb's own outline's area: the cells of ``foreground`` (a window of the view's
+        foreground map on every ``grid``-th pixel of the level ``view`` projects to, True
+        where foreground, its top-left cell ``at``) that no blob covers (``labels``, -1 on
+        the same cells) nor lies within ``UNEXPLAINED_GAP`` cells of, and within
+        ``UNEXPLAINED_REACH`` times the limb's length (its joint to the far end of its bone)
+        of its joint, at the pose ``kin``. ``areas``: each blob's whole outline's area in
+        square level pixels (``raycast.outline_areas``). A limb tracked off its place in
+        the image leaves its own pixels there, beside it."""
+        covered = labels >= 0
+        out = np.zeros(len(self))
+        if not covered.any():
+            return out
+        gap = cv2.distanceTransform((~covered).astype(np.uint8), cv2.DIST_L2,
+                                    cv2.DIST_MASK_PRECISE)
+        ys, xs = np.nonzero(foreground & (gap > UNEXPLAINED_GAP))
+        if not len(ys):
+            return out
+        cells = np.stack([xs, ys], 1) + np.asarray(at)
+        joint = view.project(kin.world_points(self.joint, self.joint_ref)) / grid
+        axis = view.project(kin.world_points(self.axis_joint, self.axis_ref)) / grid
+        length = np.zeros(len(self))
+        np.maximum.at(length, self.axis_limb,
+                      np.linalg.norm(axis - joint[self.axis_limb], axis=1))
+        near = np.sum((cells[None] - joint[:, None]) ** 2, -1) <= (
+            UNEXPLAINED_REACH * length[:, None]) ** 2
+        mine = self.of_blob >= 0
+        own = np.bincount(self.of_blob[mine], weights=areas[mine], minlength=len(self))
+        return np.where(own > 0, near.sum(1) * grid**2 / np.maximum(own, 1e-12), 0.0)
+
     def bone_off_body(self, kin: Kinematics, views: Sequence[Camera],
                       to_body: Sequence[np.ndarray | None]) -> np.ndarray:
         """(L, V): per limb and view, the share of the limb's bone points at the pose ``kin``
@@ -181,15 +234,18 @@ class Limbs:
         return out
 
     def checks(self, per_view: Sequence[np.ndarray], doubted: Collection[str] = (),
-               flagged: Collection[str] | None = None) -> dict[str, LimbCheck]:
+               flagged: Collection[str] | None = None, unexplained: np.ndarray | None = None
+               ) -> dict[str, LimbCheck]:
         """Each limb's check from its agreement in every view (``view_agreement``'s);
         ``doubted`` and ``flagged``: the limbs the tracker doubted and the report flagged
-        on the frame before (None: those doubted)."""
+        on the frame before (None: those doubted); ``unexplained``: one view's
+        ``unexplained`` (None: none)."""
         out = {}
         for i, name in enumerate(self.names):
             views = tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
                           for a in per_view)
             seen = [v for v in views if v is not None]
             out[name] = LimbCheck(min(seen) if seen else 0.0, views, name in doubted,
-                                  None if flagged is None else name in flagged)
+                                  None if flagged is None else name in flagged,
+                                  0.0 if unexplained is None else float(unexplained[i]))
         return out

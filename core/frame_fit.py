@@ -676,8 +676,8 @@ class FrameFit:
                      flagged: Collection[str] | None) -> dict[str, LimbCheck]:
         """Each limb's confidence at the finest level's pose ``kin`` (``core.confidence``):
         per view, its mapped pixels' support (1 for a perfect match) and how much of its
-        bone lies on the silhouette; ``doubted`` and ``flagged``: the limbs doubted and
-        flagged on the frame before."""
+        bone lies on the silhouette; with one view, the foreground no blob explains near
+        it; ``doubted`` and ``flagged``: the limbs doubted and flagged on the frame before."""
         top = 1 + self.settings.outlier_density
         axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
         per_view = []
@@ -697,7 +697,23 @@ class FrameFit:
                 code = crop[px[inside, 1], px[inside, 0]]
                 on[inside] = np.where(code == sil.UNSURE, np.nan, code == sil.FOREGROUND)
             per_view.append(self._limbs.view_agreement(ps.blob, support, on))
-        return self._limbs.checks(per_view, doubted, flagged)
+        return self._limbs.checks(per_view, doubted, flagged,
+                                  self._unexplained(kin, smp, fgs) if self.seq.n_views == 1
+                                  else None)
+
+    def _unexplained(self, kin: Kinematics, smp: _Samples, fgs: list | None
+                     ) -> np.ndarray | None:
+        """One view's ``Limbs.unexplained`` at the finest level's pose ``kin`` (its samples
+        ``smp``, its foreground crops ``fgs``), or None where the view has no backdrop."""
+        if fgs is None or fgs[0] is None:
+            return None
+        crop, at, _ = fgs[0]
+        lv = self.scales.view_level(0, 0)
+        view = kin.pose.views[0].at_level(lv)
+        labels = smp.shape_parts[0].grid.window(*at, crop.shape)
+        return self._limbs.unexplained(
+            kin, view, self.scales.grid(0, lv), crop == sil.FOREGROUND, at, labels,
+            raycast.outline_areas(view, self._blobs, kin.segments))
 
     def _trust(self, delta: np.ndarray) -> np.ndarray:
         """The step shortened so that no joint turns more than ``max_step`` degrees: far from

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.confidence import ONE_VIEW_FLAG, UNSEEN, UNSURE_FLAG, Limbs
+from core.confidence import CLEAR, DOUBT, UNSEEN, UNSURE_FLAG, Limbs
 from core.pose import CALIBRATED, BodyPose
 from core.raycast import BlobStack
 from core.settings import TrackerSettings
@@ -25,14 +25,15 @@ def _report(frames) -> dict:
     """The report's frames (``core.run.report``'s ``frames``) of tracked results, its
     confidences unrounded."""
     return {"frames": [{"limbs": {n: {"confidence": c.confidence, "views": list(c.views),
-                                      "flag": c.flag} for n, c in fr.limbs.items()}}
+                                      "flag": c.flag, "unexplained": c.unexplained}
+                                  for n, c in fr.limbs.items()}}
                        for fr in frames]}
 
 
 def test_read_again_at_the_bars_in_use_a_one_view_report_gives_the_trackers_flags_back():
     """Side-on in one view, the near forearm gone on one frame: every limb's flag read again
-    from the report at ``ONE_VIEW_FLAG`` is the tracker's, and bars that never flag leave
-    only the limbs no view sees."""
+    from the report at the tracker's bars (and the unexplained foreground's weight in use)
+    is the tracker's, and bars that never flag leave only the limbs no view sees."""
     sk = human_template()
     pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
                     [side_view(yaw_deg=90)])
@@ -45,7 +46,7 @@ def test_read_again_at_the_bars_in_use_a_one_view_report_gives_the_trackers_flag
     result = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
                    [0, 1, 2, 3])
     rep = _report(result.frames)
-    again = reflagged(rep, *ONE_VIEW_FLAG)
+    again = reflagged(rep, DOUBT, CLEAR)
     assert again == rep
     assert any(c["flag"] == UNSURE_FLAG for fr in rep["frames"] for c in fr["limbs"].values())
     never = reflagged(rep, 0.0, 0.0)
@@ -65,3 +66,11 @@ def test_a_flag_is_carried_to_the_next_frame_and_a_given_frame_starts_afresh():
     assert arm == [None, UNSURE_FLAG, UNSURE_FLAG, "", None, ""]
     assert all(fr["limbs"]["Leg"]["flag"] == UNSEEN for fr in got["frames"] if fr["limbs"])
     assert rep["frames"][1]["limbs"]["Arm"]["flag"] == "?"  # the report itself is kept
+
+
+def test_the_unexplained_foreground_discounts_the_confidence_the_flag_reads():
+    rep = {"frames": [{"limbs": {"Arm": {"confidence": 0.5, "views": [0.5], "flag": "?",
+                                         "unexplained": 1.0}}}]}
+    for weight, flag in ((0.0, ""), (0.4, ""), (0.5, UNSURE_FLAG), (1.0, UNSURE_FLAG)):
+        got = reflagged(rep, 0.35, 0.9, weight)  # 0.5 / (1 + weight) against 0.35
+        assert got["frames"][0]["limbs"]["Arm"]["flag"] == flag, weight

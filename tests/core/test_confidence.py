@@ -6,13 +6,15 @@ import copy
 import numpy as np
 import pytest
 
-from core import confidence
+from core import confidence, raycast, se3
+from core import confidence as confidence_module
 from core import silhouette as sil
 from core.confidence import (
     CLEAR,
     DOUBT,
     MIN_LIMB_POINTS,
-    ONE_VIEW_FLAG,
+    UNEXPLAINED_GAP,
+    UNEXPLAINED_REACH,
     UNSEEN,
     UNSURE_FLAG,
     LimbCheck,
@@ -141,6 +143,50 @@ def test_a_limb_is_as_sure_as_its_worst_seeing_view_and_unseen_when_no_view_sees
     assert DOUBT > 0.2 and not any(c.doubted for c in checks.values())
 
 
+def test_unexplained_foreground_near_each_limb_is_counted_cell_by_cell(template):
+    """``Limbs.unexplained`` against a loop over a window of the label map: the foreground
+    cells no blob covers, farther than the gap from every covered cell (the distance to each
+    one), within the reach of the limb's joint, over the pixels its blobs cover when cast
+    alone."""
+    sk = template
+    rng = np.random.default_rng(5)
+    R = np.array([se3.exp_so3(rng.normal(0, 0.3, 3)) for _ in range(sk.n_joints)])
+    view = side_view(yaw_deg=70)
+    kin = Kinematics(sk, BodyPose(R, sk.rest_positions[0].copy(), [view]))
+    limbs, grid, shape = _limbs(sk), 2, (360, 320)
+    at, size = (15, 10), (160, 130)  # the window: map cells x 15.., y 10..
+    labels = raycast.label_grid(view, sk.blobs, kin.segments, shape, grid).window(*at, size)
+    covered = labels >= 0
+    foreground = covered.copy()
+    ys, xs = np.mgrid[0:size[0], 0:size[1]]
+    for cx, cy, r in rng.uniform([0, 0, 3], [size[1], size[0], 12], (12, 3)):
+        foreground |= (xs - cx) ** 2 + (ys - cy) ** 2 <= r * r  # patches no blob explains
+    areas = raycast.outline_areas(view, sk.blobs, kin.segments)
+    got = limbs.unexplained(kin, view, grid, foreground, at, labels, areas)
+
+    cov = np.argwhere(covered)
+    loose = [(y, x) for y, x in np.argwhere(foreground & ~covered)
+             if np.min(np.hypot(*(cov - (y, x)).T)) > UNEXPLAINED_GAP]
+    M = sk.joint_frames(R, sk.rest_positions[0])
+    g = kin.segments
+    for i, name in enumerate(limbs.names):
+        joint = view.project(M[sk.index(name)][:3, 3][None])[0] / grid
+        mine = [b for b, k in enumerate(limbs.of_blob) if k == i]
+        far = 0.0
+        for b in mine:  # the blob's long axis, AXIS_REACH of its long radius either way
+            blob = sk.blobs[b]
+            k = int(np.argmax(blob.radii))
+            for t in (-confidence.AXIS_REACH, confidence.AXIS_REACH):
+                ref = blob.centre + t * blob.radii[k] * blob.Q[:, k]
+                X = g[blob.joint, :3, :3] @ ref + g[blob.joint, :3, 3]
+                far = max(far, float(np.linalg.norm(view.project(X[None])[0] / grid - joint)))
+        near = sum(np.hypot(x + at[0] - joint[0], y + at[1] - joint[1])
+                   <= UNEXPLAINED_REACH * far for y, x in loose)
+        own = sum(len(raycast.render_labels(view, [sk.blobs[b]], g, shape)[0]) for b in mine)
+        assert got[i] == pytest.approx(near * grid**2 / own, rel=0.06, abs=1e-9), name
+    assert np.count_nonzero(got) >= 3  # the patches lie near some limbs, not all
+
+
 @pytest.mark.parametrize("confidence, doubted, flag", [
     (DOUBT - 0.01, False, UNSURE_FLAG), (DOUBT + 0.01, False, ""),
     (DOUBT + 0.01, True, UNSURE_FLAG), (CLEAR - 0.01, True, UNSURE_FLAG),
@@ -152,38 +198,51 @@ def test_a_limb_in_doubt_stays_flagged_until_its_confidence_is_clear(confidence,
     assert LimbCheck(0.0, (None, None), doubted).flag == UNSEEN
 
 
-@pytest.mark.parametrize("confidence, before, flag", [
-    (ONE_VIEW_FLAG[0] - 0.01, False, UNSURE_FLAG), (ONE_VIEW_FLAG[0] + 0.01, False, ""),
-    (ONE_VIEW_FLAG[1] - 0.01, True, UNSURE_FLAG), (ONE_VIEW_FLAG[1] + 0.01, True, "")])
-def test_one_view_flags_by_its_own_bars_and_the_tracker_doubts_by_its_own(confidence, before,
-                                                                           flag):
-    """With one view the report's flag enters and leaves at ONE_VIEW_FLAG's bars, each from
-    its own state on the frame before, while the tracker's doubt keeps DOUBT and CLEAR;
-    with two views the two are one."""
-    assert DOUBT < ONE_VIEW_FLAG[0] < ONE_VIEW_FLAG[1] and CLEAR < ONE_VIEW_FLAG[1]
-    one = LimbCheck(confidence, (confidence,), doubted=False, was_flagged=before)
-    assert one.flag == flag and one.doubt == (UNSURE_FLAG if confidence < DOUBT else "")
-    assert LimbCheck(confidence, (confidence,), doubted=before).flag == flag  # None: as doubted
-    two = LimbCheck(confidence, (confidence, 0.99), doubted=False, was_flagged=before)
-    assert two.flag == two.doubt == (UNSURE_FLAG if confidence < DOUBT else "")
-    assert LimbCheck(0.0, (None,), was_flagged=before).flag == UNSEEN
+@pytest.mark.parametrize("unexplained", [0.0, 0.4, 1.5])
+@pytest.mark.parametrize("confidence", [DOUBT - 0.01, DOUBT + 0.01, 0.6, CLEAR - 0.01,
+                                        CLEAR + 0.01])
+@pytest.mark.parametrize("before", [False, True])
+def test_one_view_flags_what_its_unexplained_foreground_discounts_the_tracker_doubts_plainly(
+        confidence, unexplained, before):
+    """With one view the report's flag reads the confidence over one plus
+    UNEXPLAINED_WEIGHT times the unexplained foreground, at the tracker's bars, from its own
+    state on the frame before; the tracker's doubt reads the plain confidence; with two views
+    the two are one whatever the foreground."""
+    read = confidence / (1 + confidence_module.UNEXPLAINED_WEIGHT * unexplained)
+    one = LimbCheck(confidence, (confidence,), doubted=False, was_flagged=before,
+                    unexplained=unexplained)
+    assert one.flag_confidence == pytest.approx(read)
+    assert one.flag == (UNSURE_FLAG if read < (CLEAR if before else DOUBT) else "")
+    assert one.doubt == (UNSURE_FLAG if confidence < DOUBT else "")
+    assert LimbCheck(confidence, (confidence,), doubted=before,
+                     unexplained=unexplained).flag == one.flag  # None: as doubted
+    two = LimbCheck(confidence, (confidence, 0.99), doubted=before, was_flagged=False,
+                    unexplained=unexplained)
+    assert two.flag == two.doubt
+    assert LimbCheck(0.0, (None,), was_flagged=before, unexplained=unexplained).flag == UNSEEN
+
+
+def _swung_forearm(sk, frames: int, degrees: float = 80.0):
+    """One side view of the body standing still, its near forearm swung ``degrees`` in the
+    image from the second of ``frames`` frames on: the first pose, and the footage."""
+    view = side_view(yaw_deg=90)
+    still = np.tile(np.eye(3), (sk.n_joints, 1, 1))
+    pose = BodyPose(still, sk.rest_positions[0].copy(), [view])
+    swung = still.copy()
+    swung[sk.index("RightElbow")] = se3.exp_so3(view.pose.R[2] * np.radians(degrees))
+    moved = BodyPose(swung, pose.root_position, [view])
+    return pose, [[render(sk, pose if k == 0 else moved, 0, noise=0.01, seed=k)
+                   for k in range(frames)]]
 
 
 def test_one_views_flags_follow_their_own_frame_before_and_do_not_steer_the_tracker(
         template, monkeypatch):
-    """Tracked side-on in one view, with the near forearm gone for a frame: every frame's
-    checks know which limbs the tracker doubted and which the report flagged on the frame
-    before, apart. Flags raised to catch fair-reading limbs change what the report shows,
-    not one pose: the tracker holds what it doubts, not what is flagged for a look."""
+    """Tracked side-on in one view, with the near forearm swung beyond the fit's reach: every
+    frame's checks know which limbs the tracker doubted and which the report flagged on the
+    frame before, apart. The unexplained foreground weighed far more changes what the report
+    shows, not one pose: the tracker holds what it doubts, not what is flagged for a look."""
     sk = copy.deepcopy(template)
-    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
-                    [side_view(yaw_deg=90)])
-    limbs = _limbs(sk)
-    without = copy.deepcopy(sk)
-    without.blobs = [b for b, i in zip(sk.blobs, limbs.of_blob)
-                     if i < 0 or limbs.names[i] != "RightElbow"]
-    frames = [[render(sk if k != 1 else without, pose, 0, noise=0.01, seed=k)
-               for k in range(4)]]
+    pose, frames = _swung_forearm(sk, 4)
 
     def run():
         return track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
@@ -191,7 +250,7 @@ def test_one_views_flags_follow_their_own_frame_before_and_do_not_steer_the_trac
 
     as_set = run()
     flags_as_set = sum(len(f.flagged) for f in as_set)  # read before the bars change
-    monkeypatch.setattr(confidence, "ONE_VIEW_FLAG", (0.7, 0.99))
+    monkeypatch.setattr(confidence, "UNEXPLAINED_WEIGHT", 1e3)
     raised = run()
     parted = 0
     for before, now in zip(raised[1:], raised[2:]):
@@ -205,6 +264,28 @@ def test_one_views_flags_follow_their_own_frame_before_and_do_not_steer_the_trac
         assert {n: c.doubt for n, c in a.limbs.items()} == {
             n: c.doubt for n, c in b.limbs.items()}
     assert sum(len(f.flagged) for f in raised) > flags_as_set
+
+
+def test_one_view_flags_a_forearm_left_behind_where_its_pixels_lie_unexplained(template):
+    """One view, a forearm swung 80 degrees in the image between two frames, too far for the
+    fit to follow (no search): the forearm's own pixels are foreground no blob explains,
+    beside where it is tracked, more than near any other limb, and the flag reads its
+    confidence over one plus that, weighed. The shins, far from them, have none."""
+    sk = copy.deepcopy(template)
+    pose, frames = _swung_forearm(sk, 3)
+    swung = se3.exp_so3(pose.views[0].pose.R[2] * np.radians(80))
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
+                [0, 1, 2])
+    tracked = res.frames[1].pose.rotations[sk.index("RightElbow")]
+    assert np.degrees(se3.rotation_angle_between(tracked, swung)) > 40
+    checks = res.frames[1].limbs
+    arm = checks["RightElbow"]
+    assert arm.unexplained > 0.2 and arm.flag == UNSURE_FLAG, arm
+    assert arm.flag_confidence == pytest.approx(
+        arm.confidence / (1 + confidence.UNEXPLAINED_WEIGHT * arm.unexplained))
+    assert arm.unexplained == max(c.unexplained for c in checks.values())
+    for shin in ("LeftKnee", "RightKnee"):  # the forearm's pixels are beyond their reach
+        assert checks[shin].unexplained == 0.0, checks[shin]
 
 
 def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
