@@ -169,10 +169,7 @@ class LabelGrid:
     def full(self, shape) -> np.ndarray:
         """The labels on the map of every ``step``-th pixel of an image of ``shape``
         (ceil(H / step), ceil(W / step)), whose pixel (i, j) is pixel (step j, step i)."""
-        out = np.full((-(-shape[0] // self.step), -(-shape[1] // self.step)), -1, np.int32)
-        i, j = self._at
-        out[i:i + self.label.shape[0], j:j + self.label.shape[1]] = self.label
-        return out
+        return self.window(0, 0, (-(-shape[0] // self.step), -(-shape[1] // self.step)))
 
     def window(self, x0: int, y0: int, shape: tuple[int, int]) -> np.ndarray:
         """The labels of ``full``'s map on its cells (y0 .. y0 + h, x0 .. x0 + w), -1 where no
