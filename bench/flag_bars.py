@@ -48,7 +48,7 @@ def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED
             before = {}
         for name, check in fr["limbs"].items():
             seen = any(v is not None for v in check["views"])
-            confidence = check["confidence"] / (1.0 + weight * check.get("unexplained", 0.0))
+            confidence = check["confidence"] / (1.0 + weight * (check.get("unexplained") or 0))
             check["flag"] = reading(confidence, seen, before.get(name, False), enter, clear)
             before[name] = bool(check["flag"])
     return out

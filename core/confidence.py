@@ -25,8 +25,10 @@ blob explains, beside the limb (``Limbs.unexplained``: within ``UNEXPLAINED_REAC
 length from its joint, past ``UNEXPLAINED_GAP`` of the blobs' outline, in units of the
 limb's own outline's area). So with one view the flag reads, at the tracker's own bars, the
 confidence divided by one plus ``UNEXPLAINED_WEIGHT`` times that
-(``LimbCheck.flag_confidence``), each from its own frame before. Hands, feet and hair have
-no blob and add a little near the forearms, shanks and neck on every frame alike. The
+(``LimbCheck.flag_confidence``), each from its own frame before; a view with no backdrop
+(a camera that moves, the silhouette off) cannot tell it, and its flag reads the confidence
+under the higher bars of ``ONE_VIEW_FLAG``, which the flags had before. Hands, feet and hair
+have no blob and add a little near the forearms, shanks and neck on every frame alike. The
 tracker's own doubt reads the plain confidence there too: it holds a doubted limb where it
 was, which costs more than a look.
 """
@@ -53,6 +55,7 @@ UNEXPLAINED_REACH = 1.2  # limb lengths from its joint: where a view's unexplain
 # counts against the limb
 UNEXPLAINED_GAP = 2.5  # map cells: foreground this near the blobs' outline is its own slack
 UNEXPLAINED_WEIGHT = 0.85  # with one view, the flag's discount per limb area unexplained
+ONE_VIEW_FLAG = (0.55, 0.99)  # one view's flag's bars where no backdrop shows what is unexplained
 UNSEEN, UNSURE_FLAG = "unseen", "unsure"
 
 
@@ -61,13 +64,14 @@ class LimbCheck:
     """One limb on one frame: its confidence in [0, 1], per view its agreement in [0, 1]
     (None where the view does not see it), whether the tracker doubted it on the frame
     before (``doubted``) and the report flagged it there (``was_flagged``; None: the same),
-    and with one view the foreground no blob explains near it (``Limbs.unexplained``)."""
+    and with one view the foreground no blob explains near it (``Limbs.unexplained``; None
+    where the view has no backdrop to tell it, and with more views)."""
 
     confidence: float
     views: tuple[float | None, ...]
     doubted: bool = False
     was_flagged: bool | None = None
-    unexplained: float = 0.0
+    unexplained: float | None = None
 
     @property
     def doubt(self) -> str:
@@ -78,22 +82,25 @@ class LimbCheck:
     def flag(self) -> str:
         """What the report and the add-on show: '' when the limb can be trusted, else
         ``unseen`` or ``unsure`` (the tracker's doubt, but with one view the reading of
-        ``flag_confidence``)."""
+        ``flag_confidence``, or without a backdrop the confidence at ``ONE_VIEW_FLAG``)."""
         if len(self.views) > 1:
             return self.doubt
         before = self.doubted if self.was_flagged is None else self.was_flagged
+        if self.unexplained is None:
+            return self._reading(before, self.confidence, *ONE_VIEW_FLAG)
         return self._reading(before, self.flag_confidence)
 
     @property
     def flag_confidence(self) -> float:
         """The confidence the one-view flag reads: divided by one plus ``UNEXPLAINED_WEIGHT``
         times the foreground no blob explains near the limb, in units of its own outline's
-        area."""
-        return self.confidence / (1.0 + UNEXPLAINED_WEIGHT * self.unexplained)
+        area (the confidence itself where that is not known)."""
+        return self.confidence / (1.0 + UNEXPLAINED_WEIGHT * (self.unexplained or 0.0))
 
-    def _reading(self, before: bool, confidence: float) -> str:
-        return reading(confidence, any(v is not None for v in self.views), before, DOUBT,
-                       CLEAR)
+    def _reading(self, before: bool, confidence: float, enter: float = DOUBT,
+                 leave: float = CLEAR) -> str:
+        return reading(confidence, any(v is not None for v in self.views), before, enter,
+                       leave)
 
 
 def reading(confidence: float, seen: bool, before: bool, enter: float, leave: float) -> str:
@@ -239,7 +246,7 @@ class Limbs:
         """Each limb's check from its agreement in every view (``view_agreement``'s);
         ``doubted`` and ``flagged``: the limbs the tracker doubted and the report flagged
         on the frame before (None: those doubted); ``unexplained``: one view's
-        ``unexplained`` (None: none)."""
+        ``unexplained`` (None: not known)."""
         out = {}
         for i, name in enumerate(self.names):
             views = tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
@@ -247,5 +254,5 @@ class Limbs:
             seen = [v for v in views if v is not None]
             out[name] = LimbCheck(min(seen) if seen else 0.0, views, name in doubted,
                                   None if flagged is None else name in flagged,
-                                  0.0 if unexplained is None else float(unexplained[i]))
+                                  None if unexplained is None else float(unexplained[i]))
         return out

@@ -77,7 +77,8 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
                 "limbs": {name: {"confidence": round(c.confidence, 3), "flag": c.flag,
                                  "views": [None if v is None else round(v, 3)
                                            for v in c.views],
-                                 "unexplained": round(c.unexplained, 3)}
+                                 "unexplained": None if c.unexplained is None
+                                 else round(c.unexplained, 3)}
                           for name, c in f.limbs.items()},
             }
             for f in result.frames

@@ -13,6 +13,7 @@ from core.confidence import (
     CLEAR,
     DOUBT,
     MIN_LIMB_POINTS,
+    ONE_VIEW_FLAG,
     UNEXPLAINED_GAP,
     UNEXPLAINED_REACH,
     UNSEEN,
@@ -220,6 +221,28 @@ def test_one_view_flags_what_its_unexplained_foreground_discounts_the_tracker_do
                     unexplained=unexplained)
     assert two.flag == two.doubt
     assert LimbCheck(0.0, (None,), was_flagged=before, unexplained=unexplained).flag == UNSEEN
+
+
+@pytest.mark.parametrize("confidence, before, flag", [
+    (ONE_VIEW_FLAG[0] - 0.01, False, UNSURE_FLAG), (ONE_VIEW_FLAG[0] + 0.01, False, ""),
+    (ONE_VIEW_FLAG[1] - 0.01, True, UNSURE_FLAG), (ONE_VIEW_FLAG[1] + 0.01, True, "")])
+def test_one_view_without_a_backdrop_flags_at_its_own_higher_bars(confidence, before, flag):
+    """Where one view has no backdrop to show what no blob explains (None), its flag reads
+    the plain confidence under ONE_VIEW_FLAG's bars, above the tracker's."""
+    assert DOUBT < ONE_VIEW_FLAG[0] < ONE_VIEW_FLAG[1] and CLEAR < ONE_VIEW_FLAG[1]
+    one = LimbCheck(confidence, (confidence,), was_flagged=before, unexplained=None)
+    assert one.flag == flag and one.flag_confidence == confidence
+
+
+def test_a_one_view_track_without_its_silhouette_knows_no_unexplained_foreground(template):
+    """The silhouette off, no backdrop: every check's unexplained foreground is None (not
+    known), so the flags read ONE_VIEW_FLAG's bars."""
+    sk = copy.deepcopy(template)
+    pose, frames = _swung_forearm(sk, 2)
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0, silhouette=0)),
+                pose, [0, 1])
+    assert res.frames[1].limbs and all(c.unexplained is None
+                                       for c in res.frames[1].limbs.values())
 
 
 def _swung_forearm(sk, frames: int, degrees: float = 80.0):

@@ -156,9 +156,9 @@ def test_the_report_is_strict_json_with_limb_checks_and_its_bvh_ends_before_a_di
     assert rep["frames_to_check"] == [1]
     assert rep["frames"][1]["limbs"] == {
         "LeftKnee": {"confidence": 0.2, "flag": "unsure", "views": [0.2, None, 0.9],
-                     "unexplained": 0.0},
+                     "unexplained": None},
         "RightKnee": {"confidence": 0.8, "flag": "", "views": [0.8, 0.9, 0.9],
-                      "unexplained": 0.0}}
+                      "unexplained": None}}
 
 
 def test_an_image_that_cannot_be_read_is_named_before_any_frame_is_tracked(footage, tmp_path):
