@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 from suite import CACHE, RUNS, flag_counts, slug, tracked_and_true  # noqa: E402
 
-from core.confidence import CLEAR, DOUBT, UNEXPLAINED_WEIGHT, reading  # noqa: E402
+from core.confidence import CLEAR, DOUBT, UNEXPLAINED_WEIGHT, discounted, reading  # noqa: E402
 
 
 def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED_WEIGHT
@@ -48,7 +48,7 @@ def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED
             before = {}
         for name, check in fr["limbs"].items():
             seen = any(v is not None for v in check["views"])
-            confidence = check["confidence"] / (1.0 + weight * (check.get("unexplained") or 0))
+            confidence = discounted(check["confidence"], check.get("unexplained"), weight)
             check["flag"] = reading(confidence, seen, before.get(name, False), enter, clear)
             before[name] = bool(check["flag"])
     return out

@@ -95,12 +95,20 @@ class LimbCheck:
         """The confidence the one-view flag reads: divided by one plus ``UNEXPLAINED_WEIGHT``
         times the foreground no blob explains near the limb, in units of its own outline's
         area (the confidence itself where that is not known)."""
-        return self.confidence / (1.0 + UNEXPLAINED_WEIGHT * (self.unexplained or 0.0))
+        return discounted(self.confidence, self.unexplained)
 
     def _reading(self, before: bool, confidence: float, enter: float = DOUBT,
                  leave: float = CLEAR) -> str:
         return reading(confidence, any(v is not None for v in self.views), before, enter,
                        leave)
+
+
+def discounted(confidence: float, unexplained: float | None, weight: float | None = None
+               ) -> float:
+    """``confidence`` over one plus ``weight`` (None: ``UNEXPLAINED_WEIGHT``) times the
+    unexplained foreground (None: not known, so the confidence itself)."""
+    weight = UNEXPLAINED_WEIGHT if weight is None else weight
+    return confidence / (1.0 + weight * (unexplained or 0.0))
 
 
 def reading(confidence: float, seen: bool, before: bool, enter: float, leave: float) -> str:

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from core import confidence, raycast, se3
-from core import confidence as confidence_module
 from core import silhouette as sil
 from core.confidence import (
     CLEAR,
@@ -16,6 +15,7 @@ from core.confidence import (
     ONE_VIEW_FLAG,
     UNEXPLAINED_GAP,
     UNEXPLAINED_REACH,
+    UNEXPLAINED_WEIGHT,
     UNSEEN,
     UNSURE_FLAG,
     LimbCheck,
@@ -209,7 +209,7 @@ def test_one_view_flags_what_its_unexplained_foreground_discounts_the_tracker_do
     UNEXPLAINED_WEIGHT times the unexplained foreground, at the tracker's bars, from its own
     state on the frame before; the tracker's doubt reads the plain confidence; with two views
     the two are one whatever the foreground."""
-    read = confidence / (1 + confidence_module.UNEXPLAINED_WEIGHT * unexplained)
+    read = confidence / (1 + UNEXPLAINED_WEIGHT * unexplained)
     one = LimbCheck(confidence, (confidence,), doubted=False, was_flagged=before,
                     unexplained=unexplained)
     assert one.flag_confidence == pytest.approx(read)
