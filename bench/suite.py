@@ -141,9 +141,7 @@ def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
     view's floor, not three's. The same for every look whose view looks the same way, so
     fitted once per clip, run, starting frame and line of sight."""
     sk = job.skeleton
-    sight = line_of_sight(job.initial, job.moving[0] if job.moving else None)
-    body = side_on_skeleton(sk, job.initial, sight) if job.settings.side_on else sk
-    sight = sight if body is not sk else None
+    body, sight = fitted_body(job)
     key = (clip_dir, run, start, None if sight is None else tuple(np.round(sight, 3)))
     if key not in _REFERENCES:
         names = sk.tracked_joint_names()
@@ -151,6 +149,15 @@ def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
             evaluate.score(sk, names, pose, truth, limbs=limbs).limb_mean_deg
             for pose in (evaluate.held_still(truth), evaluate.best_fit(body, truth, sight)))
     return _REFERENCES[key]
+
+
+def fitted_body(job) -> tuple:
+    """The body the best fit moves for a suite job, as the tracker holds it, and the line of
+    sight it is side-on about (None where it is not tracked side-on)."""
+    sight = line_of_sight(job.initial, job.moving[0] if job.moving else None)
+    body = side_on_skeleton(job.skeleton, job.initial, sight) if job.settings.side_on \
+        else job.skeleton
+    return body, (sight if body is not job.skeleton else None)
 
 
 BAD_LIMB_DEG = 20.0  # a limb this far off the capture is one the flags should catch

@@ -1,0 +1,98 @@
+"""Where a tracked suite run loses, limb by limb and frame by frame.
+
+    python bench/limb_errors.py JOB.json [--run "3 views 15 fps"] [--start N]
+                                [--twist JOINT,...]
+
+For a job ``bench/suite.py`` tracked (its ``.bvh`` beside it, the clip's ``truth.bvh`` in its
+folder): per frame of the run, each of the eight limbs' direction error against the capture,
+and against the best fit of the tracked degrees of freedom (``suite.fitted_body``), in
+degrees. With ``--twist``, each named joint's turn against the best fit, split into its twist
+about the bone and its swing across it: an upper arm's twist sets the plane its elbow bends
+in, which no outline of the upper arm shows (``docs/RESEARCH.md``, thirty-eighth session).
+``--start`` is the frame the run started from (``__from_N`` in the job's name).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import evaluate  # noqa: E402
+from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
+
+from core import se3  # noqa: E402
+
+
+def swing_twist(R: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
+    """A rotation R (3, 3) split as R = swing @ twist, the twist about the unit ``axis`` and
+    the swing about an axis across it: (swing, twist) in degrees, the twist signed about
+    ``axis`` in (-180, 180], the swing in [0, 180] (the angle R turns ``axis`` by)."""
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    along = float(np.dot((x, y, z), axis))
+    twist = np.degrees(2 * np.arctan2(along, w))
+    twist = twist - 360 if twist > 180 else twist + 360 if twist <= -180 else twist
+    swing = np.degrees(float(se3.angle_between_vectors(axis, R @ axis)))
+    return swing, float(twist)
+
+
+def limb_errors(job_path: Path, run: str, start: int) -> tuple:
+    """The run's eight limbs' names, and per frame their errors (F, 8) against the capture
+    and against the best fit, degrees; with the job, the tracked and the best-fit poses."""
+    job, limbs, est, truth = tracked_and_true(job_path, run, start)
+    body, sight = fitted_body(job)
+    best = evaluate.best_fit(body, truth, sight)
+    sk = job.skeleton
+    names = [label for label, _, _ in limbs[:8]]
+    tracked = evaluate.limb_vectors(sk, *est, limbs)
+    errors = []
+    for ref in (truth, best):
+        v = evaluate.limb_vectors(sk, *ref, limbs)
+        errors.append(np.degrees([[float(se3.angle_between_vectors(tracked[n][f], v[n][f]))
+                                   for n in names] for f in range(len(est[0]))]))
+    return names, errors[0], errors[1], job, est, best
+
+
+def twist_rows(job, est: tuple, best: tuple, joint: str) -> np.ndarray:
+    """Per frame, ``joint``'s tracked turn against the best fit's (its segment's orientation
+    in the world), as (swing, twist) degrees about its bone (F, 2)."""
+    sk = job.skeleton
+    j = sk.index(joint)
+    axis = sk.bone_frame(j)[0]
+    out = []
+    for f in range(len(est[0])):
+        tracked = sk.joint_frames(est[0][f], est[1][f])[j][:3, :3]
+        fitted = sk.joint_frames(best[0][f], best[1][f])[j][:3, :3]
+        out.append(swing_twist(fitted.T @ tracked, axis))
+    return np.array(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("job", type=Path, help="a job bench/suite.py tracked")
+    ap.add_argument("--run", default="3 views 15 fps", choices=list(RUNS))
+    ap.add_argument("--start", type=int, default=0, help="the frame the run started from")
+    ap.add_argument("--twist", default="", help="comma-separated joints to split")
+    args = ap.parse_args(argv)
+    names, vs_truth, vs_best, job, est, best = limb_errors(args.job, args.run, args.start)
+    print("frame  " + "  ".join(f"{n[:12]:>12s}" for n in names) + "   (capture / best fit)")
+    for f, (a, b) in enumerate(zip(vs_truth, vs_best)):
+        print(f"{f:5d}  " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in zip(a, b)))
+    print("mean   " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in
+                                 zip(vs_truth.mean(0), vs_best.mean(0))))
+    for joint in filter(None, args.twist.split(",")):
+        rows = twist_rows(job, est, best, joint)
+        print(f"{joint} against the best fit, per frame: swing / twist, degrees")
+        print("  ".join(f"{s:.0f}/{t:.0f}" for s, t in rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,48 @@
+"""A joint's turn split into its twist about the bone and its swing across it, against
+rotations built from the two."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core import se3
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "bench"))
+
+from limb_errors import swing_twist  # noqa: E402
+
+AXIS = np.array([0.3, -0.5, 0.81])
+AXIS /= np.linalg.norm(AXIS)
+ACROSS = np.cross(AXIS, [1.0, 0.0, 0.0])
+ACROSS /= np.linalg.norm(ACROSS)
+
+
+def _turn(axis: np.ndarray, degrees: float) -> np.ndarray:
+    return se3.exp_so3(axis * np.radians(degrees))
+
+
+@pytest.mark.parametrize("twist", [0.0, 35.0, -120.0, 179.0])
+@pytest.mark.parametrize("swing", [0.0, 20.0, 95.0])
+def test_swing_after_twist_comes_apart(swing, twist):
+    # a swing about any axis across the bone, after a twist about it
+    across = _turn(AXIS, 40.0) @ ACROSS
+    got = swing_twist(_turn(across, swing) @ _turn(AXIS, twist), AXIS)
+    np.testing.assert_allclose(got, (swing, twist), atol=1e-6)
+
+
+def test_twist_is_signed_about_the_axis_and_wraps():
+    assert swing_twist(_turn(AXIS, -30.0), AXIS)[1] == pytest.approx(-30.0)
+    assert swing_twist(_turn(-AXIS, 30.0), AXIS)[1] == pytest.approx(-30.0)
+    assert swing_twist(_turn(AXIS, 190.0), AXIS)[1] == pytest.approx(-170.0)
+
+
+def test_swing_is_how_far_the_bone_turns():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        R = se3.exp_so3(rng.normal(size=3))
+        swing, _ = swing_twist(R, AXIS)
+        assert swing == pytest.approx(np.degrees(np.arccos(np.clip(AXIS @ R @ AXIS, -1, 1))),
+                                      abs=1e-6)
