@@ -55,8 +55,8 @@ def limb_errors(job_path: Path, run: str, start: int) -> tuple:
     errors = []
     for ref in (truth, best):
         v = evaluate.limb_vectors(sk, *ref, limbs)
-        errors.append(np.degrees([[float(se3.angle_between_vectors(tracked[n][f], v[n][f]))
-                                   for n in names] for f in range(len(est[0]))]))
+        errors.append(np.degrees(np.stack([se3.angle_between_vectors(tracked[n], v[n])
+                                           for n in names], axis=1)))
     return names, errors[0], errors[1], job, est, best
 
 
