@@ -64,14 +64,20 @@ class Scores:
     per_frame_limb_deg: np.ndarray  # (F,) mean over the eight limbs
 
 
+def limb_errors_deg(sk: Skeleton, est: tuple, truth: tuple, limbs=LIMBS) -> dict[str, np.ndarray]:
+    """Per limb, the angle (F,) in degrees between its estimated and true directions on each
+    of the frames both (rotations, roots) hold."""
+    ve, vt = limb_vectors(sk, *est, limbs), limb_vectors(sk, *truth, limbs)
+    return {k: np.degrees(se3.angle_between_vectors(ve[k], vt[k])) for k in ve}
+
+
 def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
           unit_mm: float = 1000.0, limbs=LIMBS) -> Scores:
     """Compare (rotations, roots) of an estimate with the truth over the same frames."""
     F = min(len(est[0]), len(truth[0]))
     est = (est[0][:F], est[1][:F])
     truth = (truth[0][:F], truth[1][:F])
-    ve, vt = limb_vectors(sk, *est, limbs), limb_vectors(sk, *truth, limbs)
-    per = {k: np.degrees(se3.angle_between_vectors(ve[k], vt[k])) for k in ve}
+    per = limb_errors_deg(sk, est, truth, limbs)
     pe, pt = world_points(sk, *est), world_points(sk, *truth)
     rel = (pe - pe[:, :1]) - (pt - pt[:, :1])
     local = {}

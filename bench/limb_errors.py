@@ -51,12 +51,10 @@ def limb_errors(job_path: Path, run: str, start: int) -> tuple:
     best = evaluate.best_fit(body, truth, sight)
     sk = job.skeleton
     names = [label for label, _, _ in limbs[:8]]
-    tracked = evaluate.limb_vectors(sk, *est, limbs)
     errors = []
     for ref in (truth, best):
-        v = evaluate.limb_vectors(sk, *ref, limbs)
-        errors.append(np.degrees(np.stack([se3.angle_between_vectors(tracked[n], v[n])
-                                           for n in names], axis=1)))
+        per = evaluate.limb_errors_deg(sk, est, ref, limbs)
+        errors.append(np.stack([per[n] for n in names], axis=1))
     return names, errors[0], errors[1], job, est, best
 
 
