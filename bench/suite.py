@@ -58,7 +58,6 @@ from suite_footage import (  # noqa: E402
 )
 from walk_benchmark import track_job  # noqa: E402
 
-from core import se3  # noqa: E402
 from core.bvh import read_bvh  # noqa: E402
 from core.job import load_job  # noqa: E402
 from core.side_on import line_of_sight, out_of_side_on, side_on_skeleton  # noqa: E402
@@ -169,8 +168,7 @@ def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, in
     segment's (the nearest joint above the limb's first joint that the report names), or
     the frame's body turned out of side-on, which puts every limb there in doubt."""
     bad = flagged = caught = 0
-    ve = evaluate.limb_vectors(sk, *est, limbs)
-    vt = evaluate.limb_vectors(sk, *truth, limbs)
+    errors = evaluate.limb_errors_deg(sk, est, truth, limbs)
     for fr in rep["frames"]:
         if not fr["limbs"]:
             continue
@@ -178,7 +176,7 @@ def flag_counts(rep: dict, sk, est: tuple, truth: tuple, limbs) -> tuple[int, in
         for label, a, _ in limbs[:8]:
             segment = next(sk.names[j] for j in sk.ancestors(sk.index(a))
                            if sk.names[j] in fr["limbs"])
-            off = np.degrees(se3.angle_between_vectors(ve[label][f], vt[label][f]))
+            off = errors[label][f]
             flag = bool(fr["limbs"][segment]["flag"]) or out_of_side_on(fr.get("turned"))
             bad += off > BAD_LIMB_DEG
             flagged += flag
