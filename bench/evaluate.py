@@ -231,9 +231,11 @@ def best_fit(sk: Skeleton, truth: tuple, root_axis: np.ndarray | None = None) ->
             return (sk.world_positions(R, p) - target[f]).ravel()
         # MINPACK's lm stops on a small step short of the minimum here (a thigh swung 30
         # degrees out of the image plane kept 3 cm of joint error, a body turned in depth
-        # 0.5 degrees, even at tolerances of 1e-12); trust-region steps scaled by the
-        # Jacobian's columns reach both, in about the same time
-        x = least_squares(resid, x, method="trf", x_scale="jac").x
+        # 0.5 degrees, even at tolerances of 1e-12). Trust-region steps reach both; scaled by
+        # the Jacobian's columns they did on one machine and stopped 0.4-0.6 degrees short on
+        # another, where the unscaled ones reached every test's truth to 1e-12 degrees, and
+        # sooner
+        x = least_squares(resid, x, method="trf", ftol=1e-12, xtol=1e-12, gtol=1e-12).x
         R, p = pose_of(x)
         out_R.append(R)
         out_p.append(p)
