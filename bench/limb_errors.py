@@ -1,7 +1,7 @@
 """Where a tracked suite run loses, limb by limb and frame by frame.
 
     python bench/limb_errors.py JOB.json [--run "3 views 15 fps"] [--start N]
-                                [--twist JOINT,...]
+                                [--twist JOINT,...] [--heading]
 
 For a job ``bench/suite.py`` tracked (its ``.bvh`` beside it, the clip's ``truth.bvh`` in its
 folder): per frame of the run, each of the eight limbs' direction error against the capture,
@@ -9,7 +9,11 @@ and against the best fit of the tracked degrees of freedom (``suite.fitted_body`
 degrees. With ``--twist``, each named joint's turn against the best fit, split into its twist
 about the bone and its swing across it: an upper arm's twist sets the plane its elbow bends
 in, which no outline of the upper arm shows (``docs/RESEARCH.md``, thirty-eighth session).
-``--start`` is the frame the run started from (``__from_N`` in the job's name).
+With ``--heading``, the root's turn about the vertical against the capture and the best
+fit, per frame: a body that turns can keep its trunk turned right while its pelvis, seen
+only by where the legs hang from it, lags, the lower back twisting to make up for it
+(``docs/RESEARCH.md``, forty-third session). ``--start`` is the frame the run started from
+(``__from_N`` in the job's name).
 """
 
 from __future__ import annotations
@@ -29,6 +33,8 @@ import evaluate  # noqa: E402
 from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
 
 from core import se3  # noqa: E402
+
+UP = np.array([0.0, 1.0, 0.0])  # the captures' vertical (``suite_footage``'s stage)
 
 
 def swing_twist(R: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
@@ -58,6 +64,13 @@ def limb_errors(job_path: Path, run: str, start: int) -> tuple:
     return names, errors[0], errors[1], job, est, best
 
 
+def heading_errors(est: np.ndarray, ref: np.ndarray, up: np.ndarray = UP) -> np.ndarray:
+    """Per frame, how far the root rotations ``est`` (F, 3, 3) are turned about the world's
+    ``up`` beyond ``ref`` (F, 3, 3): the twist about ``up`` of est ref^T, signed, degrees
+    (F,)."""
+    return np.array([swing_twist(e @ r.T, up)[1] for e, r in zip(est, ref)])
+
+
 def twist_rows(job, est: tuple, best: tuple, joint: str) -> np.ndarray:
     """Per frame, ``joint``'s tracked turn against the best fit's (its segment's orientation
     in the world), as (swing, twist) degrees about its bone (F, 2)."""
@@ -78,6 +91,9 @@ def main(argv=None) -> int:
     ap.add_argument("--run", default="3 views 15 fps", choices=list(RUNS))
     ap.add_argument("--start", type=int, default=0, help="the frame the run started from")
     ap.add_argument("--twist", default="", help="comma-separated joints to split")
+    ap.add_argument("--heading", action="store_true",
+                    help="the root's turn about the vertical against the capture and the "
+                    "best fit")
     args = ap.parse_args(argv)
     names, vs_truth, vs_best, job, est, best = limb_errors(args.job, args.run, args.start)
     print("frame  " + "  ".join(f"{n[:12]:>12s}" for n in names) + "   (capture / best fit)")
@@ -85,6 +101,13 @@ def main(argv=None) -> int:
         print(f"{f:5d}  " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in zip(a, b)))
     print("mean   " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in
                                  zip(vs_truth.mean(0), vs_best.mean(0))))
+    if args.heading:
+        truth = tracked_and_true(args.job, args.run, args.start)[3]
+        roots = [np.asarray(p[0])[:, 0] for p in (est, truth, best)]
+        print("the root's turn about the vertical beyond the capture / the best fit, per "
+              "frame, degrees")
+        print("  ".join(f"{a:.0f}/{b:.0f}" for a, b in zip(heading_errors(roots[0], roots[1]),
+                                                           heading_errors(roots[0], roots[2]))))
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")
