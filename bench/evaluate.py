@@ -12,10 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
 
 from core import se3
 from core.bvh import BvhFile
 from core.skeleton import HINGE, Skeleton
+
+UP = np.array([0.0, 1.0, 0.0])  # the captures' vertical (``suite_footage``'s stage)
 
 # (label, from, to): a joint name, or "<joint>/end" for that joint's first end site
 LIMBS = [
@@ -88,6 +91,15 @@ def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
     per_frame = np.mean([per[label] for label, _, _ in limbs[:8]], axis=0)
     return Scores({k: float(v.mean()) for k, v in per.items()}, float(per_frame.mean()),
                   float(np.linalg.norm(rel, axis=-1).mean() * unit_mm), local, per_frame)
+
+
+def heading_errors_deg(est: np.ndarray, ref: np.ndarray, up: np.ndarray = UP) -> np.ndarray:
+    """Per frame, how far the root rotations ``est`` (F, 3, 3) are turned about the world's
+    ``up`` beyond ``ref`` (F, 3, 3): the twist about ``up`` of est ref^T (its rotation split
+    as a swing across ``up`` after a twist about it), signed, in (-180, 180] degrees (F,)."""
+    quat = Rotation.from_matrix(np.einsum("fab,fcb->fac", est, ref)).as_quat()  # x, y, z, w
+    twist = np.degrees(2 * np.arctan2(quat[:, :3] @ up, quat[:, 3]))
+    return (twist + 180) % 360 - 180
 
 
 def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:

@@ -34,8 +34,6 @@ from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
 
 from core import se3  # noqa: E402
 
-UP = np.array([0.0, 1.0, 0.0])  # the captures' vertical (``suite_footage``'s stage)
-
 
 def swing_twist(R: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
     """A rotation R (3, 3) split as R = swing @ twist, the twist about the unit ``axis`` and
@@ -62,13 +60,6 @@ def limb_errors(job_path: Path, run: str, start: int) -> tuple:
         per = evaluate.limb_errors_deg(sk, est, ref, limbs)
         errors.append(np.stack([per[n] for n in names], axis=1))
     return names, errors[0], errors[1], job, est, best
-
-
-def heading_errors(est: np.ndarray, ref: np.ndarray, up: np.ndarray = UP) -> np.ndarray:
-    """Per frame, how far the root rotations ``est`` (F, 3, 3) are turned about the world's
-    ``up`` beyond ``ref`` (F, 3, 3): the twist about ``up`` of est ref^T, signed, degrees
-    (F,)."""
-    return np.array([swing_twist(e @ r.T, up)[1] for e, r in zip(est, ref)])
 
 
 def twist_rows(job, est: tuple, best: tuple, joint: str) -> np.ndarray:
@@ -106,8 +97,9 @@ def main(argv=None) -> int:
         roots = [np.asarray(p[0])[:, 0] for p in (est, truth, best)]
         print("the root's turn about the vertical beyond the capture / the best fit, per "
               "frame, degrees")
-        print("  ".join(f"{a:.0f}/{b:.0f}" for a, b in zip(heading_errors(roots[0], roots[1]),
-                                                           heading_errors(roots[0], roots[2]))))
+        print("  ".join(f"{a:.0f}/{b:.0f}" for a, b in zip(
+            evaluate.heading_errors_deg(roots[0], roots[1]),
+            evaluate.heading_errors_deg(roots[0], roots[2]))))
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")

@@ -219,7 +219,9 @@ def score_run(job_path: Path, run: str, start: int = 0) -> dict:
     row = {"tracker": tracker.limb_mean_deg, "still": still, "best": best,
            "tracked": rep["frames_tracked"], "of": n - 1,
            "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],
-           "peak_mb": peak_mb, "flags": flag_counts(rep, sk, est, truth, limbs)}
+           "peak_mb": peak_mb, "flags": flag_counts(rep, sk, est, truth, limbs),
+           "heading": float(np.mean(np.abs(evaluate.heading_errors_deg(
+               np.asarray(est[0])[:, 0], np.asarray(truth[0])[:, 0]))))}
     if len(views) == 1:
         height_px = sk.height() * PIXELS_PER_METRE
         px = evaluate.image_error_px(sk, est, truth, [m or c for c, m in zip(
@@ -240,7 +242,8 @@ def over_starts(runs: list[dict]) -> dict:
            "stopped": sum(r["diverged"] for r in runs), "starts": len(runs),
            "fps": statistics.median(r["fps"] for r in runs),
            "peak_mb": max(r["peak_mb"] for r in runs),
-           "flags": tuple(int(x) for x in np.sum([r["flags"] for r in runs], axis=0))}
+           "flags": tuple(int(x) for x in np.sum([r["flags"] for r in runs], axis=0)),
+           "heading": float(np.mean([r["heading"] for r in runs]))}
     if "image_pct" in runs[0]:
         row["image_pct"] = float(np.mean([r["image_pct"] for r in runs]))
     return row
@@ -376,7 +379,8 @@ def main(argv=None) -> int:
             scored.setdefault(key, []).append(row)
             print(f"{' / '.join(key)} from frame {k}: {row['tracker']:.1f}° (held still "
                   f"{row['still']:.1f}, best fit {row['best']:.1f}), "
-                  f"{row['tracked']}/{row['of']}", flush=True)
+                  f"{row['tracked']}/{row['of']}, the root's heading {row['heading']:.1f}° "
+                  "off", flush=True)
     lines = table({key: over_starts(rs) for key, rs in scored.items()}, runs)
     lines.append(f"\nsuite time {time.perf_counter() - t0:.0f} s; {len(clips)} clips x"
                  f" {len(looks)} looks x {len(runs)} runs x {starts} starting frames")

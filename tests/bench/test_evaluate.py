@@ -131,3 +131,15 @@ def test_one_views_best_fit_turns_limbs_in_the_image_plane_and_the_root_about_th
     assert off(body, (turned, p), z, limb=None) > 3
     for truth in (out_of_plane, (in_plane, p), (turned, p)):
         assert off(sk, truth, None, limb=None) < 0.01
+
+
+def test_heading_error_is_the_turn_about_the_vertical_beyond_the_reference():
+    rng = np.random.default_rng(5)
+    refs = np.array([se3.exp_so3(rng.normal(size=3)) for _ in range(4)])
+    turns = np.array([30.0, -75.0, 0.0, 170.0])
+    est = np.array([se3.exp_so3(evaluate.UP * np.radians(t)) @ r for t, r in zip(turns, refs)])
+    np.testing.assert_allclose(evaluate.heading_errors_deg(est, refs), turns, atol=1e-6)
+    # a lean about a level axis turns nothing about the vertical
+    lean = np.array([se3.exp_so3(np.array([np.cos(a), 0.0, np.sin(a)]) * np.radians(25.0)) @ r
+                     for a, r in zip((0.3, 1.2, 2.0, 4.0), refs)])
+    np.testing.assert_allclose(evaluate.heading_errors_deg(lean, refs), 0.0, atol=1e-6)

@@ -228,13 +228,15 @@ def test_runs_from_several_starts_are_scored_by_their_mean_and_summed_counts():
     from suite import over_starts
 
     runs = [{"tracker": t, "still": 30.0 + t, "best": 1.0, "tracked": k, "of": 30,
-             "diverged": k < 30, "fps": f, "peak_mb": m, "flags": (1, 2, 3)}
-            for t, k, f, m in ((10.0, 30, 5.0, 100), (14.0, 22, 6.0, 120), (12.0, 29, 4.0, 90))]
+             "diverged": k < 30, "fps": f, "peak_mb": m, "flags": (1, 2, 3), "heading": h}
+            for t, k, f, m, h in ((10.0, 30, 5.0, 100, 2.0), (14.0, 22, 6.0, 120, 9.0),
+                                  (12.0, 29, 4.0, 90, 4.0))]
     row = over_starts(runs)
     assert (row["tracker"], row["low"], row["high"]) == (12.0, 10.0, 14.0)
     assert row["still"] == 42.0 and row["best"] == 1.0
     assert (row["tracked"], row["of"], row["stopped"], row["starts"]) == (81, 90, 2, 3)
     assert row["fps"] == 5.0 and row["peak_mb"] == 120 and row["flags"] == (3, 6, 9)
+    assert row["heading"] == 5.0
     assert "image_pct" not in row
     runs[0]["image_pct"], runs[1]["image_pct"], runs[2]["image_pct"] = 1.0, 2.0, 6.0
     assert over_starts(runs)["image_pct"] == 3.0
