@@ -12,7 +12,9 @@ in, which no outline of the upper arm shows (``docs/RESEARCH.md``, thirty-eighth
 With ``--heading``, the root's turn about the vertical against the capture and the best
 fit, per frame: a body that turns can keep its trunk turned right while its pelvis, seen
 only by where the legs hang from it, lags, the lower back twisting to make up for it
-(``docs/RESEARCH.md``, forty-third session). ``--start`` is the frame the run started from
+(``docs/RESEARCH.md``, forty-third session); and how far each frame's fit turned it from
+the tracker's constant-velocity prediction, beside how far the capture was from that
+prediction. ``--start`` is the frame the run started from
 (``__from_N`` in the job's name).
 """
 
@@ -62,6 +64,20 @@ def limb_errors(job_path: Path, run: str, start: int) -> tuple:
     return names, errors[0], errors[1], job, est, best
 
 
+def predicted_roots(roots: np.ndarray, gain: float = 1.0) -> np.ndarray:
+    """The tracker's prediction (``core.pose.extrapolate``) of each frame's root rotation
+    from the tracked ones before it, ``roots`` (F, 3, 3): frame 1 from frame 0 alone (its
+    own rotation), every later one moved on by ``gain`` times the step between the two
+    before; frame 0 is the given pose itself."""
+    out = roots.copy()
+    if len(roots) > 1:
+        out[1] = roots[0]
+    for f in range(2, len(roots)):
+        step = se3.log_so3(roots[f - 2].T @ roots[f - 1])
+        out[f] = roots[f - 1] @ se3.exp_so3(gain * step)
+    return out
+
+
 def twist_rows(job, est: tuple, best: tuple, joint: str) -> np.ndarray:
     """Per frame, ``joint``'s tracked turn against the best fit's (its segment's orientation
     in the world), as (swing, twist) degrees about its bone (F, 2)."""
@@ -100,6 +116,12 @@ def main(argv=None) -> int:
         print("  ".join(f"{a:.0f}/{b:.0f}" for a, b in zip(
             evaluate.heading_errors_deg(roots[0], roots[1]),
             evaluate.heading_errors_deg(roots[0], roots[2]))))
+        pred = predicted_roots(roots[0], job.settings.prediction_gain)
+        print("how far each frame's fit turned it about the vertical from the prediction / "
+              "how far the capture was from it, degrees")
+        print("  ".join(f"{a:+.1f}/{b:+.1f}" for a, b in zip(
+            evaluate.heading_errors_deg(roots[0], pred)[1:],
+            evaluate.heading_errors_deg(roots[1], pred)[1:])))
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")

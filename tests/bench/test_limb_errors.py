@@ -47,3 +47,16 @@ def test_swing_is_how_far_the_bone_turns():
         assert swing == pytest.approx(np.degrees(np.arccos(np.clip(AXIS @ R @ AXIS, -1, 1))),
                                       abs=1e-6)
 
+
+
+def test_the_prediction_carries_the_last_step_on_and_starts_from_rest():
+    from limb_errors import predicted_roots
+    lean = _turn(ACROSS, 20.0)
+    # a body leaned, then turning 12 degrees a frame about its own axis
+    roots = np.array([lean @ _turn(AXIS, 12.0 * f) for f in range(5)])
+    pred = predicted_roots(roots)
+    np.testing.assert_allclose(pred[0], roots[0])
+    np.testing.assert_allclose(pred[1], roots[0])  # no step before the first tracked frame
+    np.testing.assert_allclose(pred[2:], roots[2:], atol=1e-12)
+    half = predicted_roots(roots, gain=0.5)
+    np.testing.assert_allclose(half[3], roots[2] @ _turn(AXIS, 6.0), atol=1e-12)
