@@ -93,13 +93,24 @@ def score(sk: Skeleton, tracked_joints: list[str], est: tuple, truth: tuple,
                   float(np.linalg.norm(rel, axis=-1).mean() * unit_mm), local, per_frame)
 
 
+def swing_twist(R: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
+    """A rotation R (3, 3) split as R = swing @ twist, the twist about the unit ``axis`` and
+    the swing about an axis across it: (swing, twist) in degrees, the twist signed about
+    ``axis`` in (-180, 180], the swing in [0, 180] (the angle R turns ``axis`` by)."""
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    along = float(np.dot((x, y, z), axis))
+    twist = np.degrees(2 * np.arctan2(along, w))
+    twist = twist - 360 if twist > 180 else twist + 360 if twist <= -180 else twist
+    swing = np.degrees(float(se3.angle_between_vectors(axis, R @ axis)))
+    return swing, float(twist)
+
+
 def heading_errors_deg(est: np.ndarray, ref: np.ndarray, up: np.ndarray = UP) -> np.ndarray:
     """Per frame, how far the root rotations ``est`` (F, 3, 3) are turned about the world's
     ``up`` beyond ``ref`` (F, 3, 3): the twist about ``up`` of est ref^T (its rotation split
-    as a swing across ``up`` after a twist about it), signed, in (-180, 180] degrees (F,)."""
-    quat = Rotation.from_matrix(np.einsum("fab,fcb->fac", est, ref)).as_quat()  # x, y, z, w
-    twist = np.degrees(2 * np.arctan2(quat[:, :3] @ up, quat[:, 3]))
-    return (twist + 180) % 360 - 180
+    as a swing across ``up`` after a twist about it: ``swing_twist``), signed, in
+    (-180, 180] degrees (F,)."""
+    return np.array([swing_twist(e @ r.T, up)[1] for e, r in zip(est, ref)])
 
 
 def motion(bvh: BvhFile) -> tuple[np.ndarray, np.ndarray]:

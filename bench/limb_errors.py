@@ -25,33 +25,22 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
+from evaluate import swing_twist  # noqa: E402
 from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
 
-from core import se3  # noqa: E402
-
-
-def swing_twist(R: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
-    """A rotation R (3, 3) split as R = swing @ twist, the twist about the unit ``axis`` and
-    the swing about an axis across it: (swing, twist) in degrees, the twist signed about
-    ``axis`` in (-180, 180], the swing in [0, 180] (the angle R turns ``axis`` by)."""
-    x, y, z, w = Rotation.from_matrix(R).as_quat()
-    along = float(np.dot((x, y, z), axis))
-    twist = np.degrees(2 * np.arctan2(along, w))
-    twist = twist - 360 if twist > 180 else twist + 360 if twist <= -180 else twist
-    swing = np.degrees(float(se3.angle_between_vectors(axis, R @ axis)))
-    return swing, float(twist)
+from core.pose import BodyPose, extrapolate  # noqa: E402
 
 
 def limb_errors(job_path: Path, run: str, start: int) -> tuple:
     """The run's eight limbs' names, and per frame their errors (F, 8) against the capture
-    and against the best fit, degrees; with the job, the tracked and the best-fit poses."""
+    and against the best fit, degrees; with the job, the tracked, the captured and the
+    best-fit poses."""
     job, limbs, est, truth = tracked_and_true(job_path, run, start)
     body, sight = fitted_body(job)
     best = evaluate.best_fit(body, truth, sight)
@@ -61,7 +50,7 @@ def limb_errors(job_path: Path, run: str, start: int) -> tuple:
     for ref in (truth, best):
         per = evaluate.limb_errors_deg(sk, est, ref, limbs)
         errors.append(np.stack([per[n] for n in names], axis=1))
-    return names, errors[0], errors[1], job, est, best
+    return names, errors[0], errors[1], job, est, truth, best
 
 
 def predicted_roots(roots: np.ndarray, gain: float = 1.0) -> np.ndarray:
@@ -72,9 +61,10 @@ def predicted_roots(roots: np.ndarray, gain: float = 1.0) -> np.ndarray:
     out = roots.copy()
     if len(roots) > 1:
         out[1] = roots[0]
+    at = np.zeros(3)  # the root's position, which the rotation's prediction does not read
     for f in range(2, len(roots)):
-        step = se3.log_so3(roots[f - 2].T @ roots[f - 1])
-        out[f] = roots[f - 1] @ se3.exp_so3(gain * step)
+        before, last = (BodyPose(R[None], at, []) for R in roots[f - 2:f])
+        out[f] = extrapolate(before, last, gain).rotations[0]
     return out
 
 
@@ -102,14 +92,14 @@ def main(argv=None) -> int:
                     help="the root's turn about the vertical against the capture and the "
                     "best fit")
     args = ap.parse_args(argv)
-    names, vs_truth, vs_best, job, est, best = limb_errors(args.job, args.run, args.start)
+    names, vs_truth, vs_best, job, est, truth, best = limb_errors(args.job, args.run,
+                                                                   args.start)
     print("frame  " + "  ".join(f"{n[:12]:>12s}" for n in names) + "   (capture / best fit)")
     for f, (a, b) in enumerate(zip(vs_truth, vs_best)):
         print(f"{f:5d}  " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in zip(a, b)))
     print("mean   " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in
                                  zip(vs_truth.mean(0), vs_best.mean(0))))
     if args.heading:
-        truth = tracked_and_true(args.job, args.run, args.start)[3]
         roots = [np.asarray(p[0])[:, 0] for p in (est, truth, best)]
         print("the root's turn about the vertical beyond the capture / the best fit, per "
               "frame, degrees")

@@ -48,7 +48,6 @@ def test_swing_is_how_far_the_bone_turns():
                                       abs=1e-6)
 
 
-
 def test_the_prediction_carries_the_last_step_on_and_starts_from_rest():
     from limb_errors import predicted_roots
     lean = _turn(ACROSS, 20.0)
