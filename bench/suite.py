@@ -28,10 +28,12 @@ once, one per core of a two-core machine; the tracking speed of a run alone, as 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import multiprocessing
 import statistics
 import sys
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from pathlib import Path
@@ -128,7 +130,8 @@ def write_job(clip_dir: Path, look: str, run: str, settings: dict, start: int = 
     return path
 
 
-_REFERENCES: dict[tuple, tuple[float, float]] = {}  # (clip, run, start, line of sight)
+REFERENCES_FILE = "references.json"  # in a clip's folder: its runs' references by digest
+_REFERENCES_LOCK = threading.Lock()  # the runs are scored on threads
 
 
 def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
@@ -137,17 +140,42 @@ def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
     A body tracked side-on (one view) is fitted as the tracker holds it: its depth-blind
     joints hinges about the line of sight (``side_on_skeleton``; a moving camera's mean,
     ``line_of_sight``), its root turning about that line alone; so the best fit is one
-    view's floor, not three's. The same for every look whose view looks the same way, so
-    fitted once per clip, run, starting frame and line of sight."""
+    view's floor, not three's. The same for every look whose view looks the same way, and
+    slow to fit (seconds a frame), so kept in the clip's ``references.json`` under the
+    digest of what they are computed from (``reference_digest``)."""
     sk = job.skeleton
     body, sight = fitted_body(job)
-    key = (clip_dir, run, start, None if sight is None else tuple(np.round(sight, 3)))
-    if key not in _REFERENCES:
-        names = sk.tracked_joint_names()
-        _REFERENCES[key] = tuple(
-            evaluate.score(sk, names, pose, truth, limbs=limbs).limb_mean_deg
-            for pose in (evaluate.held_still(truth), evaluate.best_fit(body, truth, sight)))
-    return _REFERENCES[key]
+    names = sk.tracked_joint_names()
+    key = reference_digest(sk, body, sight, truth, names, limbs)
+    path = clip_dir / REFERENCES_FILE
+    with _REFERENCES_LOCK:
+        known = json.loads(path.read_text()) if path.is_file() else {}
+    if key not in known:
+        known[key] = [evaluate.score(sk, names, pose, truth, limbs=limbs).limb_mean_deg
+                      for pose in (evaluate.held_still(truth),
+                                   evaluate.best_fit(body, truth, sight))]
+        with _REFERENCES_LOCK:  # another run's may have landed meanwhile
+            on_disk = json.loads(path.read_text()) if path.is_file() else {}
+            tmp = path.with_suffix(".tmp")
+            tmp.write_text(json.dumps({**on_disk, key: known[key]}, indent=1))
+            tmp.replace(path)
+    return tuple(known[key])
+
+
+def reference_digest(sk, body, sight, truth: tuple, names: list[str], limbs) -> str:
+    """A digest of everything a run's references follow from: the scoring and fitting code
+    (``evaluate``'s source), the skeleton scored and the body fitted, the line of sight, the
+    true poses on the run's frames, the tracked joints and the limbs."""
+    h = hashlib.sha256(Path(evaluate.__file__).read_bytes())
+    for skel in (sk, body):
+        h.update(json.dumps([skel.names, skel.kinds]).encode())
+        for arr in (skel.parents, skel.offsets, skel.axes, skel.limits, skel.hinge_zero):
+            h.update(b"-" if arr is None else np.ascontiguousarray(arr, float).tobytes())
+    h.update(b"-" if sight is None else np.asarray(sight, float).tobytes())
+    for arr in truth:
+        h.update(np.ascontiguousarray(arr, float).tobytes())
+    h.update(json.dumps([names, limbs]).encode())
+    return h.hexdigest()
 
 
 def fitted_body(job) -> tuple:

@@ -224,6 +224,40 @@ def test_a_look_counts_as_rendered_only_whole_and_as_the_look_is_now(tmp_path, m
     assert not look_rendered(clip_dir, "park video", out)
 
 
+def test_a_runs_references_are_fitted_once_and_fitted_again_when_their_frames_change(
+        tmp_path, monkeypatch):
+    """``references``: held still and the best fit are kept in the clip's file under the
+    digest of what they follow from; the same run scored again reads them back without
+    fitting, and other true frames (a later start) are fitted anew, both kept."""
+    import evaluate
+    from suite import CLIPS, REFERENCES_FILE, references, write_job
+    from suite_footage import stage
+
+    from core.job import load_job
+
+    clip_dir = tmp_path / "clip"
+    stage(CLIPS[0], clip_dir)
+    run = "1 lateral view 15 fps"
+    path = write_job(clip_dir, "muybridge", run, {})
+    for image in json.loads(path.read_text())["views"][0]["images"]:
+        (clip_dir / image).parent.mkdir(parents=True, exist_ok=True)
+        (clip_dir / image).write_bytes(b"")
+    job = load_job(path)
+    limbs = Parts.of(job.skeleton.names).limbs()
+    R, p = read_bvh(clip_dir / "truth.bvh").poses()
+    fits = []
+    fit = evaluate.best_fit
+    monkeypatch.setattr(evaluate, "best_fit", lambda *a: fits.append(1) or fit(*a))
+    first = references(clip_dir, run, 0, job, (R[0:6:2], p[0:6:2]), limbs)
+    assert len(fits) == 1 and (clip_dir / REFERENCES_FILE).is_file()
+    assert first[1] < first[0]  # the best fit beats the first pose held still
+    assert references(clip_dir, run, 0, job, (R[0:6:2], p[0:6:2]), limbs) == first
+    assert len(fits) == 1
+    later = references(clip_dir, run, 1, job, (R[1:7:2], p[1:7:2]), limbs)
+    assert len(fits) == 2 and later != first
+    assert len(json.loads((clip_dir / REFERENCES_FILE).read_text())) == 2
+
+
 def test_runs_from_several_starts_are_scored_by_their_mean_and_summed_counts():
     from suite import over_starts
 
