@@ -140,9 +140,10 @@ def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
     A body tracked side-on (one view) is fitted as the tracker holds it: its depth-blind
     joints hinges about the line of sight (``side_on_skeleton``; a moving camera's mean,
     ``line_of_sight``), its root turning about that line alone; so the best fit is one
-    view's floor, not three's. The same for every look whose view looks the same way, and
-    slow to fit (seconds a frame), so kept in the clip's ``references.json`` under the
-    digest of what they are computed from (``reference_digest``)."""
+    view's floor, not three's. The same for every look whose view looks the same way (a
+    panning camera's mean line of sight is its own, and its body's fit with it), and slow
+    to fit (seconds a frame), so kept in the clip's ``references.json`` under the digest of
+    what they are computed from (``reference_digest``)."""
     sk = job.skeleton
     body, sight = fitted_body(job)
     names = sk.tracked_joint_names()
