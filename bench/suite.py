@@ -134,8 +134,7 @@ REFERENCES_FILE = "references.json"  # in a clip's folder: its runs' references 
 _REFERENCES_LOCK = threading.Lock()  # the runs are scored on threads
 
 
-def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
-               ) -> tuple[float, float]:
+def references(clip_dir: Path, job, truth: tuple, limbs) -> tuple[float, float]:
     """Held still and the best fit of the tracked degrees of freedom over the run's frames.
     A body tracked side-on (one view) is fitted as the tracker holds it: its depth-blind
     joints hinges about the line of sight (``side_on_skeleton``; a moving camera's mean,
@@ -150,17 +149,21 @@ def references(clip_dir: Path, run: str, start: int, job, truth: tuple, limbs
     key = reference_digest(sk, body, sight, truth, names, limbs)
     path = clip_dir / REFERENCES_FILE
     with _REFERENCES_LOCK:
-        known = json.loads(path.read_text()) if path.is_file() else {}
+        known = _kept_references(path)
     if key not in known:
         known[key] = [evaluate.score(sk, names, pose, truth, limbs=limbs).limb_mean_deg
                       for pose in (evaluate.held_still(truth),
                                    evaluate.best_fit(body, truth, sight))]
         with _REFERENCES_LOCK:  # another run's may have landed meanwhile
-            on_disk = json.loads(path.read_text()) if path.is_file() else {}
             tmp = path.with_suffix(".tmp")
-            tmp.write_text(json.dumps({**on_disk, key: known[key]}, indent=1))
+            tmp.write_text(json.dumps({**_kept_references(path), key: known[key]}, indent=1))
             tmp.replace(path)
     return tuple(known[key])
+
+
+def _kept_references(path: Path) -> dict:
+    """A clip's ``references.json``: digest -> [held still, best fit]; empty before any."""
+    return json.loads(path.read_text()) if path.is_file() else {}
 
 
 def reference_digest(sk, body, sight, truth: tuple, names: list[str], limbs) -> str:
@@ -244,7 +247,7 @@ def score_run(job_path: Path, run: str, start: int = 0) -> dict:
     job, limbs, est, truth = tracked_and_true(job_path, run, start)
     sk, n = job.skeleton, len(truth[0])
     tracker = evaluate.score(sk, sk.tracked_joint_names(), est, truth, limbs=limbs)
-    still, best = references(job_path.parent, run, start, job, truth, limbs)
+    still, best = references(job_path.parent, job, truth, limbs)
     row = {"tracker": tracker.limb_mean_deg, "still": still, "best": best,
            "tracked": rep["frames_tracked"], "of": n - 1,
            "diverged": bool(rep["diverged_frames"]), "fps": rep["frames_per_second"],

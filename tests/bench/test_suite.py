@@ -248,12 +248,12 @@ def test_a_runs_references_are_fitted_once_and_fitted_again_when_their_frames_ch
     fits = []
     fit = evaluate.best_fit
     monkeypatch.setattr(evaluate, "best_fit", lambda *a: fits.append(1) or fit(*a))
-    first = references(clip_dir, run, 0, job, (R[0:6:2], p[0:6:2]), limbs)
+    first = references(clip_dir, job, (R[0:6:2], p[0:6:2]), limbs)
     assert len(fits) == 1 and (clip_dir / REFERENCES_FILE).is_file()
     assert first[1] < first[0]  # the best fit beats the first pose held still
-    assert references(clip_dir, run, 0, job, (R[0:6:2], p[0:6:2]), limbs) == first
+    assert references(clip_dir, job, (R[0:6:2], p[0:6:2]), limbs) == first
     assert len(fits) == 1
-    later = references(clip_dir, run, 1, job, (R[1:7:2], p[1:7:2]), limbs)
+    later = references(clip_dir, job, (R[1:7:2], p[1:7:2]), limbs)
     assert len(fits) == 2 and later != first
     assert len(json.loads((clip_dir / REFERENCES_FILE).read_text())) == 2
 
