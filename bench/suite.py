@@ -101,9 +101,16 @@ def slug(text: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in text.lower())
 
 
+def settings_digest(settings: dict) -> str:
+    """Eight hex digits naming tracker settings: the same for the same settings in any order."""
+    return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:8]
+
+
 def write_job(clip_dir: Path, look: str, run: str, settings: dict, start: int = 0) -> Path:
     """The job tracking one run of one clip in one look (its footage rendered), from the
-    clip's frame ``start`` (posed there by the capture) on, every run's step-th frame."""
+    clip's frame ``start`` (posed there by the capture) on, every run's step-th frame. A job
+    with ``settings`` is named by a digest of them, so that its tracked files sit beside the
+    defaults' and another setting's, and screens of different settings can run at once."""
     views, step, lower_back = RUNS[run]
     truth = read_bvh(clip_dir / "truth.bvh")
     sk = skeleton_from_bvh(truth)
@@ -125,7 +132,8 @@ def write_job(clip_dir: Path, look: str, run: str, settings: dict, start: int = 
         "frame_time": step / VIDEO_FPS,
     }
     # the footage folder is named by the look itself; the job beside it
-    path = clip_dir / f"{slug(look)}__{slug(run)}{f'__from_{start}' if start else ''}.json"
+    tag = f"__settings_{settings_digest(settings)}" if settings else ""
+    path = clip_dir / f"{slug(look)}__{slug(run)}{tag}{f'__from_{start}' if start else ''}.json"
     path.write_text(json.dumps(job, indent=1))
     return path
 
@@ -372,7 +380,8 @@ def main(argv=None) -> int:
     ap.add_argument("--looks", default=",".join(LOOKS), help="comma-separated look names")
     ap.add_argument("--runs", help="comma-separated run names (default: all but the oblique "
                     "view, or --quick's)")
-    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
+    ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run "
+                    "(their jobs and tracked files named apart from the defaults')")
     ap.add_argument("--starts", type=int, help="starting frames each clip, look and run is "
                     "tracked from, its scores averaged (default 3, or 1 with --quick)")
     ap.add_argument("--workers", type=int, default=2,

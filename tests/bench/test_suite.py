@@ -191,6 +191,27 @@ def test_a_run_from_a_later_frame_is_posed_there_and_takes_every_step_th_frame_f
     np.testing.assert_allclose(job["views"][0]["camera"]["t"], np.array(full["t"])[3::2])
 
 
+def test_a_run_with_settings_is_named_apart_from_the_defaults_and_from_other_settings(
+        tmp_path):
+    """``write_job``'s name: the defaults' plain, each setting's its own (whatever the keys'
+    order), the start after it; the job holds the settings it was named by."""
+    from suite import CLIPS, write_job
+    from suite_footage import stage
+
+    clip_dir = tmp_path / "clip"
+    stage(CLIPS[0], clip_dir)
+    run = "3 views 15 fps"
+    plain = write_job(clip_dir, "muybridge", run, {})
+    a = write_job(clip_dir, "muybridge", run, {"max_step": 10, "rim_width": 0.6}, start=2)
+    same = write_job(clip_dir, "muybridge", run, {"rim_width": 0.6, "max_step": 10}, start=2)
+    other = write_job(clip_dir, "muybridge", run, {"max_step": 25}, start=2)
+    assert plain.name == "muybridge__3_views_15_fps.json"
+    assert a == same and a.name.endswith("__from_2.json") and "__settings_" in a.name
+    assert len({plain, a, other}) == 3
+    assert json.loads(a.read_text())["settings"] == {"max_step": 10, "rim_width": 0.6}
+    assert json.loads(plain.read_text())["settings"] == {}
+
+
 def test_a_look_counts_as_rendered_only_whole_and_as_the_look_is_now(tmp_path, monkeypatch):
     """``look_rendered``: every view's last frame there under the look's own stamp; a view
     short of its last frame, or a stamp of the look as it was, asks for it again. Looks
