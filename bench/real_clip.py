@@ -41,7 +41,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
-from suite import slug  # noqa: E402
+from suite import settings_digest  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import BvhFile, BvhJoint, read_bvh, write_bvh  # noqa: E402
@@ -207,7 +207,7 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
     also tracked alone from the same first pose (``one_view_table``). ``settings``: the
     tracker's settings where not the defaults (tracked in a folder of their own)."""
     settings = settings or {}
-    work = WORK / f"settings_{slug(json.dumps(settings, sort_keys=True))}" if settings else WORK
+    work = WORK / f"settings_{settings_digest(settings)}" if settings else WORK
     work.mkdir(parents=True, exist_ok=True)
     sk = human_template(lower_back=lower_back)
     cams = read_calibration(DATA / "Calib.qca.txt")
