@@ -61,7 +61,7 @@ def read_flags(text: str) -> dict[str, tuple[int, int]]:
     out = {}
     for line in text.splitlines():
         m = _FLAGS.search(line)
-        if m and line.startswith("| ") and not _ROW.match(line.strip()):
+        if m and line.startswith("| "):
             out[line.split("|")[1].strip()] = (int(m.group(1)), int(m.group(3)))
     return out
 
@@ -100,14 +100,14 @@ def compare(before_text: str, after_text: str, runs: list[str] | None = None) ->
         if run in flags_before and run in flags_after:
             (c0, r0), (c1, r1) = flags_before[run], flags_after[run]
             lines.append(f"  flags caught / right {c0} / {r0} % -> {c1} / {r1} %")
-        for k in keys:
-            way = moved(before[k], after[k])
+        ways = {k: moved(before[k], after[k]) for k in keys}
+        for k, way in ways.items():
             if way:
                 b, a = before[k], after[k]
                 lines.append(f"  {'worse' if way > 0 else 'better'}: {k[0]}, {k[1]}: "
                              f"{b.tracker:.1f} ({b.low:.1f}-{b.high:.1f}) -> "
                              f"{a.tracker:.1f} ({a.low:.1f}-{a.high:.1f})")
-        if not any(moved(before[k], after[k]) for k in keys):
+        if not any(ways.values()):
             lines.append("  no clip-look moved beyond its spread")
     return lines
 
