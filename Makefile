@@ -38,8 +38,9 @@ bench: venv
 	$(BENCH_REAL)
 
 # The real four-camera clip, tracked through its own calibration from three starting frames,
-# and each camera alone; writes docs/REAL_CLIP.md.
-BENCH_REAL = $(PY) bench/real_clip.py --starts 3 --one-view --write docs/REAL_CLIP.md \
+# each camera alone, and each scored point over the first and last frames; writes
+# docs/REAL_CLIP.md.
+BENCH_REAL = $(PY) bench/real_clip.py --starts 3 --one-view --points --write docs/REAL_CLIP.md \
 	--sheet docs/real_clip_sheet.jpg
 bench-real: venv
 	$(BENCH_REAL)

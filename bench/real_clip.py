@@ -2,7 +2,7 @@
 would, through its own calibration, and scored against reference 2-D landmarks.
 
     python bench/real_clip.py [--frames N] [--starts N] [--stiff-back] [--one-view]
-                              [--settings JSON] [--write PATH] [--sheet PATH]
+                              [--points] [--settings JSON] [--write PATH] [--sheet PATH]
 
 A human template (metres; its lower back free, as the suite's three-view runs have it) is
 fitted to the first frame's reference landmarks in all four
@@ -17,9 +17,11 @@ that matches better (the frontal view's landmarks swap sides on about 30 frames)
 last five frames apart. Beside it: the fitted first pose held still, and every frame fitted
 to its own landmarks with the tracked body's proportions (the floor the landmarks' own noise
 and the template's joint centres leave). With ``--one-view``, each camera is also tracked
-alone (a phone's one video), from the same first pose, and scored in its own image.
-``--settings`` tracks with other tracker settings (a job's ``"settings"``), in a folder of
-its own. Writes into ``.cache/real/``; ``make bench`` runs it after the suite (``make bench-real``
+alone (a phone's one video), from the same first pose, and scored in its own image. With
+``--points``, the run from the first frame is also read point by point beside the floor,
+over the first and the last five frames: where the last frames lose. ``--settings``
+tracks with other tracker settings (a job's ``"settings"``), in a folder of its own.
+Writes into ``.cache/real/``; ``make bench`` runs it after the suite (``make bench-real``
 alone), into ``docs/REAL_CLIP.md``.
 """
 
@@ -154,18 +156,50 @@ def errors_pct(sk: Skeleton, poses: list, cams, landmarks: np.ndarray, visibilit
     return out
 
 
+def point_errors_pct(sk: Skeleton, poses: list, cams, landmarks: np.ndarray,
+                     visibility: np.ndarray) -> np.ndarray:
+    """(frames, views, points in ``POINTS``' order): each scored point's distance to its
+    landmark in % of the body's height in that view, sides matched as ``errors_pct``
+    matches them (its mean over a frame's visible points), NaN where not visible."""
+    out = np.full((len(poses), len(cams), len(POINTS)), np.nan)
+    for f, (R, root) in enumerate(poses):
+        pts = point_positions(sk, R, root)
+        for c, cam in enumerate(cams):
+            d = _point_distances(pts, cam, landmarks[c, f], visibility[c, f])
+            means = _means(d)
+            if np.isfinite(min(means)):
+                height = sk.height() * cam.camera.scale_at(root)
+                out[f, c] = 100 * d[int(np.argmin(means))] / height
+    return out
+
+
+def _point_distances(pts: dict, cam, landmarks: np.ndarray, visibility: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel distances (points,) of the points ``pts`` (world), seen by ``cam``, to one
+    frame's landmarks (33, 2) of that view, NaN where the landmark is not visible: as
+    labelled, and with left and right swapped."""
+    px = {k: distort_points(cam.camera.project(v), cam.camera.K, cam.dist) for k, v in pts.items()}
+
+    def distances(match):
+        return np.array([np.linalg.norm(px[k] - landmarks[POINTS[match[k]]])
+                         if visibility[POINTS[match[k]]] > VISIBLE else np.nan
+                         for k in POINTS])
+    return distances({k: k for k in POINTS}), distances(SWAP)
+
+
 def _distances(pts: dict, cam, landmarks: np.ndarray, visibility: np.ndarray
                ) -> tuple[float, float]:
     """Mean pixel distance of the points ``pts`` (world), seen by ``cam``, to one frame's
     visible landmarks (points, 2) of that view: as labelled, and with left and right
     swapped (inf where none is visible)."""
-    px = {k: distort_points(cam.camera.project(v), cam.camera.K, cam.dist) for k, v in pts.items()}
+    return _means(_point_distances(pts, cam, landmarks, visibility))
 
-    def mean_distance(match):
-        d = [np.linalg.norm(px[k] - landmarks[POINTS[match[k]]]) for k in POINTS
-             if visibility[POINTS[match[k]]] > VISIBLE]
-        return float(np.mean(d)) if d else np.inf
-    return mean_distance({k: k for k in POINTS}), mean_distance(SWAP)
+
+def _means(distances: tuple[np.ndarray, ...]) -> tuple[float, ...]:
+    """The mean of each of ``_point_distances``' arrays over its visible points (inf where
+    none is)."""
+    return tuple(float(np.mean(d[~np.isnan(d)])) if (~np.isnan(d)).any() else np.inf
+                 for d in distances)
 
 
 def fitted_each_frame(sk: Skeleton, poses: list, cams, views, mode: str, landmarks: np.ndarray,
@@ -199,13 +233,15 @@ def fitted_each_frame(sk: Skeleton, poses: list, cams, views, mode: str, landmar
 
 
 def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
-        starts: int = 1, one_view: bool = False, settings: dict | None = None) -> list[str]:
+        starts: int = 1, one_view: bool = False, settings: dict | None = None,
+        points: bool = False) -> list[str]:
     """Fit, track and score the clip's first ``frames`` frames, from its first frame and, with
     ``starts`` over 1, from each of the next ones too (the spread a difference must beat);
     the result as Markdown (and with ``sheet``, a contact sheet of the first, middle and
     last frames of the run from the first frame there). With ``one_view``, each camera is
-    also tracked alone from the same first pose (``one_view_table``). ``settings``: the
-    tracker's settings where not the defaults (tracked in a folder of their own)."""
+    also tracked alone from the same first pose (``one_view_table``); with ``points``, the
+    run from the first frame is also read point by point (``point_table``). ``settings``:
+    the tracker's settings where not the defaults (tracked in a folder of their own)."""
     settings = settings or {}
     work = WORK / f"settings_{settings_digest(settings)}" if settings else WORK
     work.mkdir(parents=True, exist_ok=True)
@@ -227,6 +263,8 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
         n = len(tracked)
         contact_sheet(fsk, tracked, cams, [0, n // 2, n - 1], sheet)
     lines = _table(e_track, e_still, e_floor, rep, fit_log, seconds, lower_back)
+    if points:
+        lines += [""] + point_table(fsk, tracked, floor, cams, landmarks, visibility)
     if starts > 1:
         per_frame = [np.nanmean(errors_pct(r[0], r[1], cams, landmarks[:, k:], visibility[:, k:]),
                                 axis=1) for k, r in enumerate(runs)]
@@ -235,6 +273,25 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
     if one_view:
         lines += [""] + one_view_table(work, settings, frames, sk, cams, landmarks,
                                        visibility, floor)
+    return lines
+
+
+def point_table(sk: Skeleton, tracked: list, floor: list, cams, landmarks: np.ndarray,
+                visibility: np.ndarray) -> list[str]:
+    """Each scored point's distance to its landmarks over the first and the last five
+    frames (mean over the cameras), tracked beside every frame fitted to its own landmarks
+    (``fitted_each_frame``'s poses, ``floor``): which points the last frames lose on, as
+    Markdown."""
+    errors = [point_errors_pct(sk, poses, cams, landmarks, visibility)
+              for poses in (tracked, floor)]
+    lines = ["Each point (mean over the cameras, % of body height): tracked, and each frame "
+             "fitted to its landmarks", "",
+             "| point | first 5 | fitted | last 5 | fitted |", "|---|---|---|---|---|"]
+    for i, name in enumerate(POINTS):
+        label = name.replace("Elbow/end", "Wrist").replace("Knee/end", "Ankle")
+        lines.append(f"| {label} | " + " | ".join(
+            f"{np.nanmean(e[part, :, i]):.1f}" for part in (slice(0, 5), slice(-5, None))
+            for e in errors) + " |")
     return lines
 
 
@@ -347,10 +404,13 @@ def main(argv=None) -> int:
                     help="also track from each of the next starts - 1 frames (the spread)")
     ap.add_argument("--one-view", action="store_true",
                     help="also track each camera alone, from the same first pose")
+    ap.add_argument("--points", action="store_true",
+                    help="also each scored point's first and last five frames, tracked and "
+                         "each frame fitted")
     ap.add_argument("--settings", default="{}", help="tracker settings (JSON) for every run")
     args = ap.parse_args(argv)
     lines = run(args.frames, not args.stiff_back, args.sheet, args.starts, args.one_view,
-                json.loads(args.settings))
+                json.loads(args.settings), args.points)
     print("\n".join(lines))
     if args.write:
         Path(args.write).write_text("\n".join([

@@ -52,3 +52,25 @@ def test_each_frame_fitted_to_its_landmarks_finds_the_pose_they_came_from():
     errors = real_clip.errors_pct(sk, fitted, cams, xy, vis)
     assert np.all(errors < 0.05), errors
     assert np.all(real_clip.errors_pct(sk, start, cams, xy, vis) > 1.0)
+
+
+def test_each_point_reads_its_own_distance_and_the_points_average_to_the_frames_score():
+    sk = human_template(lower_back=True)
+    cams = read_calibration(real_clip.DATA / "Calib.qca.txt")
+    lm = np.load(real_clip.DATA / "mediapipe_landmarks.npz")
+    R, root = real_clip.guess_pose(sk, [c.camera for c in cams],
+                                   real_clip.ideal_points(cams, lm["xy"].astype(float), 0))
+    poses = [(R, root)] * 2
+    xy, vis = _landmarks(sk, poses, cams, swapped_view=1)
+    knee = list(real_clip.POINTS).index("LeftKnee")
+    xy[2, 1, real_clip.POINTS["LeftKnee"]] += (6.0, 8.0)  # 10 px off, frame 1, view 3
+    vis[3, 0, real_clip.POINTS["RightElbow"]] = 0.0  # not seen there
+    per_point = real_clip.point_errors_pct(sk, poses, cams, xy, vis)
+    height = sk.height() * cams[2].camera.scale_at(root)
+    assert abs(per_point[1, 2, knee] - 1000 / height) < 1e-6
+    per_point[1, 2, knee] = 0.0
+    assert np.isnan(per_point[0, 3, list(real_clip.POINTS).index("RightElbow")])
+    assert np.nanmax(per_point) < 1e-6  # the swapped view too: its sides matched back
+    np.testing.assert_allclose(np.nanmean(real_clip.point_errors_pct(sk, poses, cams, xy, vis),
+                                          axis=2),
+                               real_clip.errors_pct(sk, poses, cams, xy, vis), atol=1e-9)
