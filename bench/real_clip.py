@@ -145,22 +145,18 @@ def point_positions(sk: Skeleton, R: np.ndarray, root: np.ndarray) -> dict[str, 
 def errors_pct(sk: Skeleton, poses: list, cams, landmarks: np.ndarray, visibility: np.ndarray
                ) -> np.ndarray:
     """(frames, views): mean distance of the scored points to the visible landmarks, in %
-    of the body's height in that view, left and right matched the better way."""
-    out = np.full((len(poses), len(cams)), np.nan)
-    for f, (R, root) in enumerate(poses):
-        pts = point_positions(sk, R, root)
-        for c, cam in enumerate(cams):
-            best = min(_distances(pts, cam, landmarks[c, f], visibility[c, f]))
-            height = sk.height() * cam.camera.scale_at(root)
-            out[f, c] = 100 * best / height if np.isfinite(best) else np.nan
-    return out
+    of the body's height in that view, left and right matched the better way
+    (``point_errors_pct``'s mean over the points; NaN where none is visible)."""
+    per_point = point_errors_pct(sk, poses, cams, landmarks, visibility)
+    seen = (~np.isnan(per_point)).sum(axis=2)
+    return np.where(seen > 0, np.nansum(per_point, axis=2) / np.maximum(seen, 1), np.nan)
 
 
 def point_errors_pct(sk: Skeleton, poses: list, cams, landmarks: np.ndarray,
                      visibility: np.ndarray) -> np.ndarray:
     """(frames, views, points in ``POINTS``' order): each scored point's distance to its
-    landmark in % of the body's height in that view, sides matched as ``errors_pct``
-    matches them (its mean over a frame's visible points), NaN where not visible."""
+    landmark in % of the body's height in that view, left and right matched the way whose
+    mean over the frame's visible points is lower, NaN where not visible."""
     out = np.full((len(poses), len(cams), len(POINTS)), np.nan)
     for f, (R, root) in enumerate(poses):
         pts = point_positions(sk, R, root)
