@@ -528,7 +528,7 @@ class FrameFit:
             ok &= ~self._backdrop_pixels(view, frame, lv, pix_l, hits.label, lost)
         pix_l, label = pix_l[ok].astype(int), hits.label[ok]
         seg_joint = self._blobs.joint[label]
-        g = kin.segments[seg_joint]
+        g = kin.segments.take(seg_joint, 0)
         d = hits.world[ok] - g[:, :3, 3]
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
         value = level.stack[pix_l[:, 1], pix_l[:, 0], 0].astype(float)
@@ -606,11 +606,12 @@ class FrameFit:
             ok = np.flatnonzero(inside & visible)
             n_pts[ps.view] += len(pix)
             n_inside[ps.view] += int(inside.sum())
-            r = vals[ok, 0] - ps.value[ok]
+            vals = vals.take(ok, 0)
+            r = vals[:, 0] - ps.value[ok]
             c = np.full(len(pix), np.nan)
             c[ok] = ps.weight[ok] * mixture_cost(r, sigma[ok], s.outlier_density)
             costs.append(c)
-            parts.append((ok, world[ok], vals[ok, 1:3], r))
+            parts.append((ok, world.take(ok, 0), vals[:, 1:3], r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         measured if sigmas is None else sigmas, shape_cost, shape_parts)
 

@@ -42,7 +42,7 @@ class Kinematics:
 
     def world_points(self, seg_joint: np.ndarray, ref_points: np.ndarray) -> np.ndarray:
         """World positions (N, 3) of reference-frame points on the segments of ``seg_joint``."""
-        g = self.segments[seg_joint]
+        g = self.segments.take(seg_joint, 0)
         return np.einsum("nab,nb->na", g[:, :3, :3], ref_points) + g[:, :3, 3]
 
 
@@ -89,5 +89,5 @@ def rows(
     if D:
         a = kin.dof_axis_world
         J = xm @ a.T - m @ _cross(a, kin.dof_point_world - c).T
-        A[:, nr:] = J * kin.moves[seg_joint]
+        A[:, nr:] = J * kin.moves.take(seg_joint, 0)
     return A

@@ -204,7 +204,7 @@ class LabelGrid:
         ray = r0 + u * rx + v * ry
         lam = -1.0 / key if view.central else key  # along ``ray``
         norm = np.linalg.norm(ray, axis=1)
-        e = e0[lab] + u * ex[lab] + v * ey[lab]
+        e = e0.take(lab, 0) + u * ex.take(lab, 0) + v * ey.take(lab, 0)
         rim = self._disc[rows, cols] * a[lab] ** 2 / np.sum(e * e, 1)  # (b^2 - a c) / |e|^2
         return Hits(lab, lam * norm, o0 + u * ox + v * oy + lam[:, None] * ray,
                     np.minimum(rim, 1.0))
