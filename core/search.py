@@ -114,13 +114,13 @@ def span_sums(lo: np.ndarray, hi: np.ndarray, S: np.ndarray) -> np.ndarray:
     """Per candidate (K, B blobs each, spans (K, B, rows) from ``spans``): the sum over its
     outline (the union of its blobs' ellipses) of the box image whose row prefix sums are S
     (rows, cols + 1). Overlaps of two ellipses are taken out once; a pixel under three of one
-    candidate's is counted twice."""
-    rows = np.arange(S.shape[0])
-    total = np.sum(S[rows, hi] - S[rows, lo], axis=(1, 2))
+    candidate's is counted twice. Read from S's flat array: ``take`` beats 2-D indexing."""
+    at, flat = np.arange(0, S.size, S.shape[1]), S.ravel()  # each row's start in flat
+    total = np.sum(flat.take(hi + at) - flat.take(lo + at), axis=(1, 2))
     for i, k in itertools.combinations(range(lo.shape[1]), 2):
-        a = np.maximum(lo[:, i], lo[:, k])  # the overlap's span, empty where b <= a
-        b = np.maximum(np.minimum(hi[:, i], hi[:, k]), a)
-        total -= np.sum(S[rows, b] - S[rows, a], axis=1)
+        a = np.maximum(lo[:, i], lo[:, k]) + at  # the overlap's span, empty where b <= a
+        b = np.maximum(np.minimum(hi[:, i], hi[:, k]) + at, a)
+        total -= np.sum(flat.take(b) - flat.take(a), axis=1)
     return total
 
 
