@@ -75,6 +75,7 @@ class Backdrop:
         # pixels whose backdrop is only painted in
         self.unseen = np.zeros(body.shape, bool) if clean else self.widen(body)
         self.image, self.colour = grey.copy(), None if colour is None else colour.copy()
+        self._colour_half = None  # ``colour`` at ``recoloured``'s resolution, when made
         if self.unseen.any():
             holes = self.unseen.astype(np.uint8)
             img8 = to_uint8(grey)
@@ -121,6 +122,7 @@ class Backdrop:
         self.image[seen] = grey[seen]
         if self.colour is not None and colour is not None:
             self.colour[seen] = colour[seen]
+            self._colour_half = None
         self.unseen &= ~seen
 
     @property
@@ -155,7 +157,9 @@ class Backdrop:
         in_colour = self.chroma_noise is not None and colour is not None and \
             backdrop_colour is not None and colour.shape == backdrop_colour.shape
         if in_colour and not self.reach and self.chroma_noise > 0:
-            fg[:h, :w] |= self.recoloured(colour[:h, :w], backdrop_colour[:h, :w])
+            own = against is None and backdrop_colour.shape[:2] == (h, w)
+            fg[:h, :w] |= self.recoloured(colour[:h, :w],
+                                          None if own else backdrop_colour[:h, :w])
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
         if in_colour:
             off_backdrop = fg > 0
@@ -174,17 +178,22 @@ class Backdrop:
         and still be called one: ``SHADOW_CHROMA`` times the footage's colour noise."""
         return SHADOW_CHROMA * self.chroma_noise
 
-    def recoloured(self, seen: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
+    def recoloured(self, seen: np.ndarray, backdrop: np.ndarray | None = None) -> np.ndarray:
         """Which pixels of a frame's colour ``seen`` (H, W, 3) are no shade of their
-        ``backdrop`` colour (H, W, 3): off every brightness of it (``_chroma``) by over
-        ``colour_bar``, the shadow test's own. A body the backdrop's brightness (a grey
-        figure on a sunlit brick wall: a third of its pixels) still differs from it in
-        colour. Judged on 2 x 2 blocks, the resolution compressed footage keeps its colour
-        at (4:2:0), and a quarter of the work."""
+        ``backdrop`` colour (H, W, 3; None: this backdrop's ``colour``, of the same size):
+        off every brightness of it (``_chroma``) by over ``colour_bar``, the shadow test's
+        own. A body the backdrop's brightness (a grey figure on a sunlit brick wall: a
+        third of its pixels) still differs from it in colour. Judged on 2 x 2 blocks, the
+        resolution compressed footage keeps its colour at (4:2:0), and a quarter of the
+        work; this backdrop's own blocks are kept until it learns."""
         h, w = seen.shape[:2]
-        half = ((w + 1) // 2, (h + 1) // 2)
-        f, b = (cv2.resize(x.astype(np.float32), half, interpolation=cv2.INTER_AREA)
-                for x in (seen, backdrop))
+        f = _halved(seen)
+        if backdrop is None:
+            if self._colour_half is None:
+                self._colour_half = _halved(self.colour)
+            b = self._colour_half
+        else:
+            b = _halved(backdrop)
         off = _chroma(f.reshape(-1, 3), b.reshape(-1, 3))[0].reshape(f.shape[:2])
         return cv2.resize((off > self.colour_bar).astype(np.uint8), (w, h),
                           interpolation=cv2.INTER_NEAREST)
@@ -257,6 +266,14 @@ class TurningBackdrop:
             if not unknown.any():
                 break
         return image, colour, unknown
+
+
+def _halved(colour: np.ndarray) -> np.ndarray:
+    """A colour image (H, W, 3) as float32 means of its 2 x 2 blocks (ceil(H / 2),
+    ceil(W / 2), 3)."""
+    h, w = colour.shape[:2]
+    return cv2.resize(colour.astype(np.float32), ((w + 1) // 2, (h + 1) // 2),
+                      interpolation=cv2.INTER_AREA)
 
 
 def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
