@@ -90,9 +90,10 @@ class Skeleton:
         depth = np.zeros(J, dtype=int)
         for j in range(1, J):
             depth[j] = depth[self.parents[j]] + 1
-        # the joints below the root by their number of ancestors: each generation's frames
-        # follow from the one before's at once
-        self._generations = [np.flatnonzero(depth == d) for d in range(1, depth.max() + 1)]
+        # the joints below the root by their number of ancestors, with their parents: each
+        # generation's frames follow from the one before's at once
+        self._generations = [(js, self.parents[js]) for js in
+                             (np.flatnonzero(depth == d) for d in range(1, depth.max() + 1))]
         self._dofs = None
 
     @property
@@ -204,14 +205,16 @@ class Skeleton:
         """World frames M_j (J, 4, 4) of every joint for local rotations (J, 3, 3); with
         ``offsets`` (J, 3), of the same hierarchy with those bone offsets instead."""
         offsets = self.offsets if offsets is None else offsets
-        M = np.empty((self.n_joints, 4, 4))
-        M[0] = se3.rigid(rotations[0], root_position)
-        M[1:, 3] = (0, 0, 0, 1)
-        for js in self._generations:
-            ps = self.parents[js]
-            turn = M[ps, :3, :3]
-            M[js, :3, :3] = turn @ rotations[js]
-            M[js, :3, 3] = (turn @ offsets[js, :, None])[..., 0] + M[ps, :3, 3]
+        # rotations and positions apart, gathered with take: a third of the time of indexing
+        # the (J, 4, 4) stack
+        R, p = np.empty((self.n_joints, 3, 3)), np.empty((self.n_joints, 3))
+        R[0], p[0] = rotations[0], root_position
+        for js, ps in self._generations:
+            turn = R.take(ps, 0)
+            R[js] = turn @ rotations.take(js, 0)
+            p[js] = (turn @ offsets.take(js, 0)[:, :, None])[..., 0] + p.take(ps, 0)
+        M = np.zeros((self.n_joints, 4, 4))
+        M[:, :3, :3], M[:, :3, 3], M[:, 3, 3] = R, p, 1.0
         return M
 
     def segment_motions(self, frames: np.ndarray) -> np.ndarray:
