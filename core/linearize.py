@@ -88,6 +88,7 @@ def rows(
         A[:, o:][:, ROOT_TURN] = _cross_g(d, grad)
     if D:
         a = kin.dof_axis_world
-        J = xm @ a.T - m @ _cross(a, kin.dof_point_world - c).T
-        A[:, nr:] = J * kin.moves.take(seg_joint, 0)
+        J = A[:, nr:]  # written in place
+        np.subtract(xm @ a.T, m @ _cross(a, kin.dof_point_world - c).T, out=J)
+        J *= kin.moves.take(seg_joint, 0)
     return A
