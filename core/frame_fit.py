@@ -600,9 +600,10 @@ class FrameFit:
             p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / gs[ps.view]).astype(int)
             lab = labels[ps.view]
             H, W = lab.shape
-            inb = (p_l[:, 0] >= 0) & (p_l[:, 0] < W) & (p_l[:, 1] >= 0) & (p_l[:, 1] < H)
-            visible = np.zeros(len(pix), dtype=bool)
-            visible[inb] = lab[p_l[inb, 1], p_l[inb, 0]] == ps.blob[inb]
+            x, y = p_l.T
+            inb = np.flatnonzero((x >= 0) & (x < W) & (y >= 0) & (y < H))
+            visible = np.zeros(len(pix), dtype=bool)  # the map's flat array, read with take
+            visible[inb] = lab.ravel().take(y.take(inb) * W + x.take(inb)) == ps.blob.take(inb)
             ok = np.flatnonzero(inside & visible)
             n_pts[ps.view] += len(pix)
             n_inside[ps.view] += int(inside.sum())
