@@ -458,7 +458,7 @@ class FrameFit:
         (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
         an error the backdrop's margin (as many times wider) covers."""
         g = self.scales.magnification(view)
-        covered = self._label_map(pose, kin, view, shape, 0, g)[0] >= 0
+        covered = self._label_maps(pose, kin, [shape], [0], [g], [view])[0][0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 
     def _learn_backdrops(self, res: FrameResult) -> None:
@@ -551,13 +551,17 @@ class FrameFit:
         out[limb] = far[px[:, 1], px[:, 0]] > LOST_REACH
         return out
 
-    def _label_map(self, pose: BodyPose, kin: Kinematics, view: int, shape, lv: int,
-                   grid: int) -> tuple[np.ndarray, raycast.LabelGrid]:
-        """Front-most blob (-1: none) at every ``grid``-th level pixel, as a map whose pixel
-        (i, j) is level pixel (grid i, grid j), and the z-buffer it came from."""
-        v_l = pose.views[view].at_level(lv)
-        labels = raycast.label_grid(v_l, self._blobs, kin.segments, shape, grid)
-        return labels.full(shape), labels
+    def _label_maps(self, pose: BodyPose, kin: Kinematics, shapes: list, lvs: list[int],
+                    grids: list[int], views: list[int] | None = None
+                    ) -> list[tuple[np.ndarray, raycast.LabelGrid]]:
+        """Per view (``views``, default all), the front-most blob (-1: none) at every
+        ``grids[i]``-th pixel of its level ``lvs[i]`` (of ``shapes[i]``), as a map whose pixel
+        (i, j) is level pixel (grid i, grid j), and the z-buffer it came from; the views'
+        z-buffers made together (``raycast.label_grids``)."""
+        views = range(len(pose.views)) if views is None else views
+        cams = [pose.views[c].at_level(lv) for c, lv in zip(views, lvs)]
+        made = raycast.label_grids(cams, self._blobs, kin.segments, shapes, grids)
+        return [(labels.full(shape), labels) for labels, shape in zip(made, shapes)]
 
     # --- one level -----------------------------------------------------------------------
     def sample(self, est: BodyPose, kin: Kinematics, sets: list[PointSet], levels: list,
@@ -573,8 +577,7 @@ class FrameFit:
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
         lvs = self.scales.view_levels(level)
         gs = [self.scales.grid(c, lv) for c, lv in enumerate(lvs)]
-        maps = [self._label_map(est, kin, c, levels[c].shape, lvs[c], gs[c])
-                for c in range(self.seq.n_views)]
+        maps = self._label_maps(est, kin, [lv.shape for lv in levels], lvs, gs)
         labels = [m[0] for m in maps]
         shape_cost, shape_parts = 0.0, []
         if fgs is not None:

@@ -11,6 +11,7 @@ pixel, so whole grids of pixels are a few array operations (``render_labels``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -228,55 +229,89 @@ def label_grid(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, step:
 
     Same labels as :func:`cast` on those pixels, at a fraction of the work: each blob's
     quadratic's coefficients are polynomials in the pixel, evaluated on its box."""
+    return label_grids([view], blobs, g, [shape], [step])[0]
+
+
+def label_grids(views: Sequence[Camera], blobs: list[Ellipsoid] | BlobStack, g,
+                shapes: Sequence, steps: Sequence[int]) -> list[LabelGrid]:
+    """``label_grid`` in each of ``views`` (an image of ``shapes[i]``, every ``steps[i]``-th
+    pixel) of one pose at once: the blobs are posed once, and every view's blobs are
+    z-buffered together as rows of one table (a view's grid cells apart from the others'),
+    so that numpy is called once for all views where it was once a view; the same numbers
+    as view by view."""
     blobs = BlobStack.of(blobs)
+    E = len(blobs)
     Rs, C = _posed(blobs, g)  # once, for the boxes and the blobs' normalised frames
     A = _to_unit(blobs, Rs)
-    boxes = _boxes(view, A, C) if len(blobs) else np.zeros((0, 4))
-    box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if len(blobs) else None
-    if box is None:
-        empty = np.zeros((0, 0))
-        return LabelGrid(np.zeros((0, 0), np.int64), None, step, empty, empty, view,
-                         (np.zeros(0),) + (np.zeros((0, 3)),) * 3)
-    x0, y0, x1, y1 = box
-    x0, y0 = x0 - x0 % step, y0 - y0 % step  # the grid: multiples of step
-    box = x0, y0, x1, y1
-    xs = np.arange(x0, x1, step, dtype=float)
-    ys = np.arange(y0, y1, step, dtype=float)
-    depth = np.full((len(ys), len(xs)), np.inf)
-    o0, ox, oy, r0, rx, ry = view.ray_lines()
-    # the ray in each blob's normalised frame: start w = w0 + u wx + v wy, direction
-    # e = e0 + u ex + v ey (one of the two is the same for every pixel)
-    w0 = np.einsum("eab,eb->ea", A, o0 - C)
-    wx, wy, e0, ex, ey = A @ ox, A @ oy, A @ r0, A @ rx, A @ ry
-    # |w + l e|^2 = 1 is a l^2 + 2 b l + c = 0 with a constant, b affine and c quadratic in
-    # (u, v). Under orthography (e fixed) a = |e|^2, b = w.e, c = |w|^2 - 1, and the nearer
-    # root is l. Through a pinhole (w fixed), in m = 1 / l: a = |w|^2 - 1, b = -w.e,
-    # c = |e|^2, and the nearer root is -m. Either way the root (-b - sqrt(b^2 - a c)) / a
-    # is a depth key, smaller nearer: in terms of the fixed vector f and the affine one
-    # p = p0 + u px + v py, a = |f|^2 - [pinhole], b = +-p.f, c = |p|^2 - [orthography]
-    fp = np.stack([w0, e0, ex, ey] if view.central else [e0, w0, wx, wy], 1)  # f, p0, px, py
-    dots = np.sum(fp[:, :, None] * fp[:, None], -1)  # (E, 4, 4): every pair's dot product
-    sign = -1.0 if view.central else 1.0
-    a = dots[:, 0, 0] - view.central
-    b0, bx, by = sign * dots[:, 0, 1:].T
-    c00, c0x, c0y = dots[:, 1, 1] - (not view.central), dots[:, 1, 2], dots[:, 1, 3]
+    out: list = [None] * len(views)
+    seen = []  # the views where a blob shows: (index, box, xs, ys, e0, ex, ey)
+    fps, boxes_all = [], []
+    for i, (view, shape, step) in enumerate(zip(views, shapes, steps)):
+        boxes = _boxes(view, A, C) if E else np.zeros((0, 4))
+        box = _clip_box(boxes[:, :2].min(0), boxes[:, 2:].max(0), shape, 2) if E else None
+        if box is None:
+            empty = np.zeros((0, 0))
+            out[i] = LabelGrid(np.zeros((0, 0), np.int64), None, step, empty, empty, view,
+                               (np.zeros(0),) + (np.zeros((0, 3)),) * 3)
+            continue
+        x0, y0, x1, y1 = box
+        x0, y0 = x0 - x0 % step, y0 - y0 % step  # the grid: multiples of step
+        o0, ox, oy, r0, rx, ry = view.ray_lines()
+        # the ray in each blob's normalised frame: start w = w0 + u wx + v wy, direction
+        # e = e0 + u ex + v ey (one of the two is the same for every pixel)
+        w0 = np.einsum("eab,eb->ea", A, o0 - C)
+        wx, wy, e0, ex, ey = A @ ox, A @ oy, A @ r0, A @ rx, A @ ry
+        # |w + l e|^2 = 1 is a l^2 + 2 b l + c = 0 with a constant, b affine and c quadratic
+        # in (u, v). Under orthography (e fixed) a = |e|^2, b = w.e, c = |w|^2 - 1, and the
+        # nearer root is l. Through a pinhole (w fixed), in m = 1 / l: a = |w|^2 - 1,
+        # b = -w.e, c = |e|^2, and the nearer root is -m. Either way the root
+        # (-b - sqrt(b^2 - a c)) / a is a depth key, smaller nearer: in terms of the fixed
+        # vector f and the affine one p = p0 + u px + v py, a = |f|^2 - [pinhole],
+        # b = +-p.f, c = |p|^2 - [orthography]
+        fps.append(np.stack([w0, e0, ex, ey] if view.central else [e0, w0, wx, wy], 1))
+        boxes_all.append(boxes)
+        seen.append((i, (x0, y0, x1, y1), np.arange(x0, x1, step, dtype=float),
+                     np.arange(y0, y1, step, dtype=float), e0, ex, ey))
+    if not seen:
+        return out
+    # from here on one row per view and blob, a view's E rows after the one before's; per
+    # view its grid's first pixel (x0, y0), its image's width and height, its step, its
+    # grid's columns and rows and whether it is a pinhole
+    K = len(seen)
+    per_row = np.repeat(np.arange(K), E)
+    views_grid = np.array([(*box[:2], shapes[i][1], shapes[i][0], steps[i], len(x), len(y),
+                            views[i].central) for i, box, x, y, *_ in seen])
+    n_cols, n_rows = views_grid[:, 5], views_grid[:, 6]
+    rows_grid = views_grid.take(per_row, 0)
+    central = rows_grid[:, 7].astype(float)
+    fp = np.concatenate(fps)  # (K E, 4, 3): f, p0, px, py
+    dots = np.sum(fp[:, :, None] * fp[:, None], -1)  # (K E, 4, 4): every pair's dot product
+    a = dots[:, 0, 0] - central
+    b0, bx, by = (np.where(central > 0, -1.0, 1.0)[:, None] * dots[:, 0, 1:]).T
+    c00, c0x, c0y = dots[:, 1, 1] - (1 - central), dots[:, 1, 2], dots[:, 1, 3]
     cxx, cxy, cyy = dots[:, 2, 2], dots[:, 2, 3], dots[:, 3, 3]
     d00, dx, dy = b0 * b0 - a * c00, 2 * (b0 * bx - a * c0x), 2 * (b0 * by - a * c0y)
     dxx, dxy, dyy = bx * bx - a * cxx, 2 * (bx * by - a * cxy), by * by - a * cyy
     # each blob's grid columns and rows: its box widened by a pixel, clipped to the image
-    H, W = shape
+    boxes = np.concatenate(boxes_all)
+    origin, step = rows_grid[:, :2], rows_grid[:, 4:5]
     lo = np.maximum(np.floor(boxes[:, :2]) - 1, 0)
-    hi = np.minimum(np.ceil(boxes[:, 2:]) + 2, [W, H])
-    first = np.maximum(-((np.array([x0, y0]) - lo) // step), 0).astype(int)
-    stop = np.minimum(np.maximum(-((np.array([x0, y0]) - hi) // step), 0),
-                      [len(xs), len(ys)]).astype(int)
+    hi = np.minimum(np.ceil(boxes[:, 2:]) + 2, rows_grid[:, 2:4])
+    first = np.maximum(-((origin - lo) // step), 0).astype(int)
+    stop = np.minimum(np.maximum(-((origin - hi) // step), 0), rows_grid[:, 5:7]).astype(int)
+    # each view's grid columns and rows, as a row of a table as wide as the widest
+    nx, ny = n_cols.max(), n_rows.max()
+    xs, ys = np.zeros((K, nx)), np.zeros((K, ny))
+    for k, (_, _, x, y, *_) in enumerate(seen):
+        xs[k, :len(x)], ys[k, :len(y)] = x, y
+    xs, ys = xs.take(per_row, 0), ys.take(per_row, 0)
     # over the whole grid at once, per blob, divided by a^2 (so that sqrt(disc) / a is one
     # root) and by -a: disc / a^2 = DV(v) + DU(u) + v KUV(u), depth = BV(v) + BU(u) - sqrt
     a2 = (a * a)[:, None]
     DU, KUV = (dxx[:, None] * xs + dx[:, None]) * xs / a2, dxy[:, None] * xs / a2
     DV = ((dyy[:, None] * ys + dy[:, None]) * ys + d00[:, None]) / a2
     BU, BV = -bx[:, None] * xs / a[:, None], -(b0[:, None] + by[:, None] * ys) / a[:, None]
-    # every blob's box cells in one flat list: blob, grid row and column of each
+    # every blob's box cells in one flat list: row (view and blob), grid row and column
     cols_n, rows_n = np.maximum(stop - first, 0).T
     size = rows_n * cols_n
     blob = np.repeat(np.arange(len(size)), size)
@@ -285,24 +320,34 @@ def label_grid(view: Camera, blobs: list[Ellipsoid] | BlobStack, g, shape, step:
     r, c = np.divmod(k, width)
     r += first[blob, 1]
     c += first[blob, 0]
-    at_r, at_c = blob * len(ys) + r, blob * len(xs) + c  # into the (E, rows), (E, cols) tables
-    disc = DV.take(at_r) + DU.take(at_c) + ys.take(r) * KUV.take(at_c)
-    hit = disc > 0
-    r, c, at_r, at_c, disc, blob = r[hit], c[hit], at_r[hit], at_c[hit], disc[hit], blob[hit]
+    at_r, at_c = blob * ny + r, blob * nx + c  # into the (K E, rows), (K E, cols) tables
+    disc = DV.take(at_r) + DU.take(at_c) + ys.take(at_r) * KUV.take(at_c)
+    # (the hits kept by their indices: take is several times faster than a boolean mask)
+    hit = np.flatnonzero(disc > 0)
+    r, c, at_r, at_c, disc, blob = (x.take(hit) for x in (r, c, at_r, at_c, disc, blob))
     lam = BV.take(at_r) + BU.take(at_c) - np.sqrt(disc)
-    if view.central:  # what lies behind the pinhole is not seen (m < 0)
-        ahead = lam < 0
-        r, c, blob, disc, lam = r[ahead], c[ahead], blob[ahead], disc[ahead], lam[ahead]
-    # the z-buffer: per cell the nearest hit, the first blob on a tie
-    cell = r * len(xs) + c
-    flat_depth = depth.ravel()
-    np.minimum.at(flat_depth, cell, lam)
-    front = lam == flat_depth[cell]
+    if central.any():  # what lies behind a pinhole is not seen (m < 0)
+        ahead = np.flatnonzero((lam < 0) | (central.take(blob) == 0))
+        r, c, blob, disc, lam = (x.take(ahead) for x in (r, c, blob, disc, lam))
+    # the z-buffer: per cell the nearest hit, the first blob on a tie; the views' grids one
+    # after the other
+    sizes = n_rows * n_cols
+    at = np.cumsum(sizes) - sizes  # each view's first cell
+    cell = at.take(per_row).take(blob) + r * n_cols.take(per_row).take(blob) + c
+    depth = np.full(sizes.sum(), np.inf)
+    np.minimum.at(depth, cell, lam)
+    front = lam == depth[cell]
     flat_label = np.full(depth.size, len(size))
     np.minimum.at(flat_label, cell[front], blob[front])
-    label = np.where(flat_label < len(size), flat_label, -1).reshape(depth.shape)
     disc_front = np.zeros(depth.size)
     won = front & (flat_label[cell] == blob)
     disc_front[cell[won]] = disc[won]
-    disc_front = disc_front.reshape(depth.shape)
-    return LabelGrid(label, box, step, depth, disc_front, view, (a, e0, ex, ey))
+    for k, (i, box, _, _, e0, ex, ey) in enumerate(seen):
+        part = slice(at[k], at[k] + sizes[k])
+        shape = (n_rows[k], n_cols[k])
+        own = flat_label[part]
+        label = np.where(own < len(size), own - k * E, -1).reshape(shape)
+        out[i] = LabelGrid(label, box, steps[i], depth[part].reshape(shape),
+                           disc_front[part].reshape(shape), views[i],
+                           (a[k * E:(k + 1) * E], e0, ex, ey))
+    return out
