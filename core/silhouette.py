@@ -280,7 +280,9 @@ def _chroma(seen: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndar
     """How far colours ``seen`` (N, 3) are from their ``backdrop`` colours (N, 3) scaled to
     fit them best (a length in 0-255 units), and that scale: a pixel under a shadow is its
     backdrop scaled, with no colour off it."""
-    f, b = seen.T.astype(np.float32), backdrop.T.astype(np.float32)  # (3, N): per channel
+    # (3, N): a channel a row, each row contiguous (a transpose's copy would keep the
+    # channels interleaved, and every operation below strided)
+    f, b = (np.ascontiguousarray(x.T, np.float32) for x in (seen, backdrop))
     scale = (f[0] * b[0] + f[1] * b[1] + f[2] * b[2]) / np.maximum(
         b[0] * b[0] + b[1] * b[1] + b[2] * b[2], 1.0)
     off = f - scale * b
