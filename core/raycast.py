@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .camera import Camera
+from .image import true_pixels
 from .skeleton import Ellipsoid
 
 
@@ -160,7 +161,7 @@ class LabelGrid:
 
     def covered(self) -> tuple[np.ndarray, np.ndarray]:
         """Grid rows and columns of the cells a blob covers, in row-major order."""
-        return np.nonzero(self.label >= 0)
+        return true_pixels(self.label >= 0)
 
     def pixels(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Pixel coordinates (N, 2) of grid cells, as floats."""

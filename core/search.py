@@ -30,6 +30,7 @@ import numpy as np
 from . import se3
 from .camera import Camera
 from .confidence import Limbs
+from .image import true_pixels
 from .linearize import Kinematics
 from .pose import BodyPose
 from .raycast import BlobStack, blob_frames
@@ -100,7 +101,7 @@ def paint(mask: np.ndarray, view: Camera, A: np.ndarray, C: np.ndarray, box: tup
     """Set the pixels of ``mask`` (the box's size) that any ellipsoid's outline covers."""
     c, half, P = outlines(view, A, C)
     lo, hi = spans(c, half, P, box)
-    e, rows = np.nonzero(hi > lo)
+    e, rows = true_pixels(hi > lo)
     # +1 where a span starts, -1 one past its end: a pixel is covered where the running sum
     # along its row is positive
     width = mask.shape[1] + 1

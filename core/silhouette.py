@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from .camera import Camera, Pinhole, turn_homography, turns_in_place
-from .image import to_float, to_uint8
+from .image import to_float, to_uint8, true_pixels
 
 MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called foreground
 UNCOVERED_WEIGHT = 0.3  # of foreground no blob covers: parts the blobs lack (hands, feet)
@@ -414,7 +414,7 @@ def mismatch(labels: np.ndarray, fg: np.ndarray, cap: float, slack: float = SLAC
                                        (covered & background, nearest_fg, False, 1.0)):
         if not src.any() or not nearest.mask.any():
             continue
-        ys, xs = np.nonzero(src)
+        ys, xs = true_pixels(src)
         iy, ix = nearest(ys, xs)
         dist = np.hypot(iy - ys, ix - xs)
         cost += w * float(np.sum(np.maximum(np.minimum(dist, cap) - slack, 0) ** 2))
