@@ -162,9 +162,12 @@ class Backdrop:
                                           None if own else backdrop_colour[:h, :w])
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
         if in_colour:
-            off_backdrop = fg > 0
+            # the pixels off the backdrop by their flat indices: take reads their colours
+            # several times faster than a 2-D boolean mask
+            off_backdrop = np.flatnonzero(fg > 0)
             unsure = np.zeros(fg.shape, np.uint8)
-            unsure[off_backdrop] = self.shaded(colour[off_backdrop], backdrop_colour[off_backdrop])
+            unsure.ravel()[off_backdrop] = self.shaded(
+                *(c.reshape(-1, 3).take(off_backdrop, 0) for c in (colour, backdrop_colour)))
             # specks too: a shadow is a patch, a lone pixel the backdrop's colour is noise
             unsure = cv2.morphologyEx(unsure, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
             fg[unsure > 0] = UNSURE
