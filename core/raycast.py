@@ -136,6 +136,14 @@ def _boxes(view: Camera, A: np.ndarray, C: np.ndarray) -> np.ndarray:
     return np.concatenate([c - half, c + half], 1)
 
 
+def _squares(x: np.ndarray) -> np.ndarray:
+    """|x|^2 (N,) of rows x (N, 3): the squares added left to right, as ``np.sum`` over the
+    rows would add them, without its reduction's cost on a short axis (five times as
+    much on a few thousand rows)."""
+    x2 = x * x
+    return x2[:, 0] + x2[:, 1] + x2[:, 2]
+
+
 def _clip_box(lo, hi, shape, margin: int):
     H, W = shape
     x0, y0 = max(int(np.floor(lo[0])) - margin, 0), max(int(np.floor(lo[1])) - margin, 0)
@@ -205,9 +213,9 @@ class LabelGrid:
         u, v = pixels[:, :1], pixels[:, 1:]
         ray = r0 + u * rx + v * ry
         lam = -1.0 / key if view.central else key  # along ``ray``
-        norm = np.linalg.norm(ray, axis=1)
+        norm = np.sqrt(_squares(ray))
         e = e0.take(lab, 0) + u * ex.take(lab, 0) + v * ey.take(lab, 0)
-        rim = self._disc[rows, cols] * a[lab] ** 2 / np.sum(e * e, 1)  # (b^2 - a c) / |e|^2
+        rim = self._disc[rows, cols] * a[lab] ** 2 / _squares(e)  # (b^2 - a c) / |e|^2
         return Hits(lab, lam * norm, o0 + u * ox + v * oy + lam[:, None] * ray,
                     np.minimum(rim, 1.0))
 
