@@ -283,16 +283,17 @@ def label_grids(views: Sequence[Camera], blobs: list[Ellipsoid] | BlobStack, g,
                      np.arange(y0, y1, step, dtype=float), e0, ex, ey))
     if not seen:
         return out
-    # from here on one row per view and blob, a view's E rows after the one before's; per
-    # view its grid's first pixel (x0, y0), its image's width and height, its step, its
-    # grid's columns and rows and whether it is a pinhole
+    # from here on one row per view and blob, a view's E rows after the one before's, each
+    # with its view's grid's first pixel (x0, y0), image width and height, step, grid
+    # columns and rows, and whether it is a pinhole
     K = len(seen)
     per_row = np.repeat(np.arange(K), E)
-    views_grid = np.array([(*box[:2], shapes[i][1], shapes[i][0], steps[i], len(x), len(y),
-                            views[i].central) for i, box, x, y, *_ in seen])
-    n_cols, n_rows = views_grid[:, 5], views_grid[:, 6]
-    rows_grid = views_grid.take(per_row, 0)
-    central = rows_grid[:, 7].astype(float)
+    n_cols, n_rows = np.array([(len(x), len(y)) for _, _, x, y, *_ in seen]).T
+    origin = np.array([box[:2] for _, box, *_ in seen]).take(per_row, 0)
+    image_wh = np.array([(shapes[i][1], shapes[i][0]) for i, *_ in seen]).take(per_row, 0)
+    step = np.array([steps[i] for i, *_ in seen]).take(per_row)[:, None]
+    grid_wh = np.stack([n_cols, n_rows], 1).take(per_row, 0)
+    central = np.array([views[i].central for i, *_ in seen], float).take(per_row)
     fp = np.concatenate(fps)  # (K E, 4, 3): f, p0, px, py
     dots = np.sum(fp[:, :, None] * fp[:, None], -1)  # (K E, 4, 4): every pair's dot product
     a = dots[:, 0, 0] - central
@@ -303,11 +304,10 @@ def label_grids(views: Sequence[Camera], blobs: list[Ellipsoid] | BlobStack, g,
     dxx, dxy, dyy = bx * bx - a * cxx, 2 * (bx * by - a * cxy), by * by - a * cyy
     # each blob's grid columns and rows: its box widened by a pixel, clipped to the image
     boxes = np.concatenate(boxes_all)
-    origin, step = rows_grid[:, :2], rows_grid[:, 4:5]
     lo = np.maximum(np.floor(boxes[:, :2]) - 1, 0)
-    hi = np.minimum(np.ceil(boxes[:, 2:]) + 2, rows_grid[:, 2:4])
+    hi = np.minimum(np.ceil(boxes[:, 2:]) + 2, image_wh)
     first = np.maximum(-((origin - lo) // step), 0).astype(int)
-    stop = np.minimum(np.maximum(-((origin - hi) // step), 0), rows_grid[:, 5:7]).astype(int)
+    stop = np.minimum(np.maximum(-((origin - hi) // step), 0), grid_wh).astype(int)
     # each view's grid columns and rows, as a row of a table as wide as the widest
     nx, ny = n_cols.max(), n_rows.max()
     xs, ys = np.zeros((K, nx)), np.zeros((K, ny))

@@ -170,3 +170,21 @@ def test_a_pinhole_shows_nearer_blobs_larger():
         boxes = raycast.blob_boxes(view, blobs, g)
         widths = boxes[:, 2] - boxes[:, 0]
         assert widths[1] / widths[0] == pytest.approx(ratio, rel=0.02)
+
+
+def test_label_grids_of_several_views_are_each_views_own_label_grid():
+    """One pose's views z-buffered together (an orthographic view, a pinhole, one whose
+    image the body misses; sizes and steps apart) give each view what it gives alone."""
+    sk, g = _posed(4)
+    views = [side_view(yaw_deg=30), side_pinhole(yaw_deg=60), side_view(center=(-900, 180))]
+    shapes, steps = [(350, 310), (300, 400), (350, 310)], [2, 1, 3]
+    together = raycast.label_grids(views, sk.blobs, g, shapes, steps)
+    assert together[2].box is None and together[0].box is not None
+    for view, shape, step, grid in zip(views, shapes, steps, together):
+        alone = raycast.label_grid(view, sk.blobs, g, shape, step)
+        assert grid.box == alone.box and grid.step == alone.step
+        np.testing.assert_array_equal(grid.label, alone.label)
+        rows, cols = grid.covered()
+        for a, b in zip(vars(grid.hits(rows, cols)).values(),
+                        vars(alone.hits(rows, cols)).values()):
+            np.testing.assert_array_equal(a, b)
