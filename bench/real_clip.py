@@ -265,6 +265,7 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
         per_frame = [np.nanmean(errors_pct(r[0], r[1], cams, landmarks[:, k:], visibility[:, k:]),
                                 axis=1) for k, r in enumerate(runs)]
         lines += ["", _spread([np.mean(e) for e in per_frame],
+                              [np.mean(e[:5]) for e in per_frame],
                               [np.mean(e[-5:]) for e in per_frame])]
     if one_view:
         lines += [""] + one_view_table(work, settings, frames, sk, cams, landmarks,
@@ -380,13 +381,17 @@ def _frames(movie, start: int, stop: int):
     return movie.select(list(range(start, min(stop, len(movie)))))
 
 
-def _spread(means: list[float], last_fives: list[float]) -> str:
-    """One line on the runs from several starting frames."""
-    def stat(x):
-        return f"{np.mean(x):.1f} ({min(x):.1f}-{max(x):.1f})"
+def _spread(means: list[float], first_fives: list[float], last_fives: list[float]) -> str:
+    """One line on the runs from several starting frames: each start's mean over all its
+    frames, its first and last five, and its last five over its first five (how far the track
+    drifts from the user's pose), as the mean over the starts and their range."""
+    def stat(x, digits=1):
+        return f"{np.mean(x):.{digits}f} ({min(x):.{digits}f}-{max(x):.{digits}f})"
+    ratios = [last / first for first, last in zip(first_fives, last_fives)]
     return (f"From frames 0-{len(means) - 1}, each start's first pose fitted to that frame's "
-            f"landmarks (mean over the starts, their range): all frames {stat(means)}, last "
-            f"five {stat(last_fives)}: a change inside that range is no change.")
+            f"landmarks (mean over the starts, their range): all frames {stat(means)}, first "
+            f"five {stat(first_fives)}, last five {stat(last_fives)}, last five over first five "
+            f"{stat(ratios, 2)}x: a change inside that range is no change.")
 
 
 def main(argv=None) -> int:

@@ -74,3 +74,12 @@ def test_each_point_reads_its_own_distance_and_the_points_average_to_the_frames_
     np.testing.assert_allclose(np.nanmean(real_clip.point_errors_pct(sk, poses, cams, xy, vis),
                                           axis=2),
                                real_clip.errors_pct(sk, poses, cams, xy, vis), atol=1e-9)
+
+
+def test_the_starts_line_reads_each_starts_drift_as_its_own_last_five_over_its_first():
+    # two starts: one holding (2 -> 3, 1.5x), one drifting (1 -> 4, 4x); the ratio of the
+    # starts' means (3.5 / 1.5) would hide the one that drifts
+    line = real_clip._spread([2.5, 2.5], [2.0, 1.0], [3.0, 4.0])
+    assert "first five 1.5 (1.0-2.0)" in line
+    assert "last five 3.5 (3.0-4.0)" in line
+    assert "last five over first five 2.75 (1.50-4.00)x" in line
