@@ -120,7 +120,7 @@ class PointSet:
     seg_joint: np.ndarray  # (N,) joint whose segment holds the point
     blob: np.ndarray  # (N,) blob index, for the visibility test
     ref: np.ndarray  # (N, 3) reference-frame point
-    value: np.ndarray  # (N,) intensity in that frame
+    value: np.ndarray  # (N, C) each channel's value in that frame (C = 1: brightness alone)
     weight: np.ndarray  # (N,) rim weight times the set's weight
     lengths: tuple[int, ...] = ()  # points per frame, when several frames are joined
 
@@ -216,7 +216,8 @@ class FrameFit:
             raise InputError("the skeleton has no blobs: give its segments ellipsoids")
         self.mode = mode
         self.settings = settings or TrackerSettings()
-        self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass)
+        self.seq = ImageSequence(images, self.settings.levels, self.settings.highpass,
+                                 self.settings.colour)
         # each view's pixel sizes for the body's size there (``scale_to``), as seq is built
         self.scales = Scales.unscaled(self.seq.n_views, self.settings)
         # the key frame's points by (frame, view, level), kept while the key frame is
@@ -531,7 +532,7 @@ class FrameFit:
         g = kin.segments.take(seg_joint, 0)
         d = hits.world[ok] - g[:, :3, 3]
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
-        value = level.stack[pix_l[:, 1], pix_l[:, 0], 0].astype(float)
+        value = level.stack[pix_l[:, 1], pix_l[:, 0], :level.channels].astype(float)
         rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
         return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
 
@@ -597,8 +598,9 @@ class FrameFit:
             world = kin.world_points(ps.seg_joint, ps.ref)
             pix = est.views[ps.view].project(world)
             vals, inside = imagelib.sample(levels[ps.view], pix)
+            C = levels[ps.view].channels
             if sigmas is None:
-                measured.append(self._sigmas(ps, vals[:, 0] - ps.value, inside))
+                measured.append(self._sigmas(ps, vals[:, :C] - ps.value, inside))
             sigma = measured[-1] if sigmas is None else sigmas[k]
             p_l = np.rint(imagelib.to_level(pix, levels[ps.view]) / gs[ps.view]).astype(int)
             lab = labels[ps.view]
@@ -611,19 +613,30 @@ class FrameFit:
             n_pts[ps.view] += len(pix)
             n_inside[ps.view] += int(inside.sum())
             vals = vals.take(ok, 0)
-            r = vals[:, 0] - ps.value[ok]
+            r = vals[:, :C] - ps.value[ok]
             c = np.full(len(pix), np.nan)
             c[ok] = ps.weight[ok] * mixture_cost(r, sigma[ok], s.outlier_density)
             costs.append(c)
-            parts.append((ok, world.take(ok, 0), vals[:, 1:3], r))
+            grad = np.stack([vals[:, C:2 * C], vals[:, 2 * C:]], -1)  # (M, C, 2)
+            parts.append((ok, world.take(ok, 0), grad, r))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         measured if sigmas is None else sigmas, shape_cost, shape_parts)
 
     def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
                        ) -> np.ndarray:
-        """Weights of a point set's usable points ``ok`` with residuals ``r`` (the set's
-        points' noise scales ``sigma``): their rim weight times the EM support posterior."""
-        return ps.weight[ok] * support_weights(r, sigma[ok], self.settings.outlier_density)
+        """Weights (M, C) of a point set's usable points ``ok`` with residuals ``r`` (M, C)
+        (the set's points' noise scales ``sigma`` (N, C)): their rim weight times the EM
+        support posterior over each channel's noise scale squared."""
+        return ps.weight[ok][:, None] * support_weights(r, sigma[ok],
+                                                        self.settings.outlier_density)
+
+    def _pixel_rows(self, ps: PointSet, sigma: np.ndarray, part: tuple) -> tuple:
+        """A point set's usable points as rows, one per point and channel: their segments'
+        joints, world points (., 3), image gradients (., 2), residuals and weights."""
+        ok, world, grad, r = part
+        C = r.shape[1]
+        return (np.repeat(ps.seg_joint[ok], C), np.repeat(world, C, axis=0),
+                grad.reshape(-1, 2), r.ravel(), self._pixel_weights(ps, ok, r, sigma).ravel())
 
     def _normal_equations(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
                           sigmas: list[np.ndarray], level: int) -> NormalEquations:
@@ -631,10 +644,9 @@ class FrameFit:
         and the silhouette's rows (each mismatched pixel's two coordinates); one block of
         rows per view."""
         pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, X, grad, r, w)
-        for ps, sigma, (ok, world, grad, r) in zip(sets, sigmas, smp.parts):
-            if len(ok):
-                pieces[ps.view].append((ps.seg_joint[ok], world, grad, r,
-                                        self._pixel_weights(ps, ok, r, sigma)))
+        for ps, sigma, part in zip(sets, sigmas, smp.parts):
+            if len(part[0]):
+                pieces[ps.view].append(self._pixel_rows(ps, sigma, part))
         s = self.settings
         for c, pull in enumerate(smp.shape_parts):
             if pull is None or not len(pull.mm.weight):
@@ -658,20 +670,23 @@ class FrameFit:
         return ne
 
     def _sigmas(self, ps: PointSet, r: np.ndarray, inside: np.ndarray) -> np.ndarray:
-        """Residual scale of a point set's points (N,) from their residuals ``r`` (N,) and
-        which fell inside the image: one scale per frame the set joins."""
+        """Residual scale (N, C) of a point set's points from their residuals ``r`` (N, C)
+        and which fell inside the image: one scale per frame the set joins and channel."""
         lengths = ps.lengths or (len(r),)
         cuts = np.cumsum(lengths)[:-1]
-        scales = [robust_scale(part_r[part_in], self.settings.noise_floor)
+        scales = [[robust_scale(part_r[part_in, ch], self.settings.noise_floor)
+                   for ch in range(r.shape[1])]
                   for part_r, part_in in zip(np.split(r, cuts), np.split(inside, cuts))]
-        return np.repeat(scales, lengths)
+        return np.repeat(np.array(scales).reshape(len(lengths), r.shape[1]), lengths, axis=0)
 
     def _residual(self, sets: list[PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
         """RMS brightness error of the pixels that follow the body (support-weighted), in
-        image units: what the report calls a frame's residual."""
+        image units: what the report calls a frame's residual (colour footage's chroma
+        channels left out, so that it reads the same with colour or without)."""
         num = den = 0.0
         for ps, sigma, (ok, _, _, r) in zip(sets, sigmas, smp.parts):
-            w = self._pixel_weights(ps, ok, r, sigma)
+            w = self._pixel_weights(ps, ok, r, sigma)[:, 0]
+            r = r[:, 0]
             num += float(np.sum(w * r * r))
             den += float(np.sum(w))
         return float(np.sqrt(num / den)) if den > 0 else float("nan")
@@ -753,20 +768,17 @@ class FrameFit:
                      ) -> list[tuple]:
         """The body's pixels of ``prev_frame`` (at pose ``prev``, full resolution, every
         ``pixel_step``-th) mapped into ``frame`` under ``est``, those visible there: per view
-        (view, segment joints (N,), world points (N, 3), image gradients (N, 2),
-        brightness residuals (N,), EM support weights (N,)). For estimates made outside the
-        tracker's own system (the skeleton's refinement)."""
+        (view, then per pixel and channel (``_pixel_rows``) segment joints (N,), world points
+        (N, 3), image gradients (N, 2), residuals (N,), EM support weights (N,)). For
+        estimates made outside the tracker's own system (the skeleton's refinement)."""
         self.scale_to(prev)
         kin_prev, kin = Kinematics(self.skeleton, prev), Kinematics(self.skeleton, est)
         levels = [self.seq.pyramid(c, frame)[0] for c in range(self.seq.n_views)]
         sets = [self.point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
                 for c in range(self.seq.n_views)]
         smp = self.sample(est, kin, sets, levels, 0)
-        out = []
-        for ps, sigma, (ok, world, grad, r) in zip(sets, smp.sigmas, smp.parts):
-            w = self._pixel_weights(ps, ok, r, sigma)
-            out.append((ps.view, ps.seg_joint[ok], world, grad, r, w))
-        return out
+        return [(ps.view, *self._pixel_rows(ps, sigma, part))
+                for ps, sigma, part in zip(sets, smp.sigmas, smp.parts)]
 
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
                     predicted: BodyPose, frame: int, doubted: Collection[str] = (),

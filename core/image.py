@@ -1,6 +1,7 @@
 """Grey float images, Gaussian pyramids, gradients and bilinear sampling.
 
-Images are float32 arrays (height, width) with values in [0, 1]; pixel (x, y) is column x,
+Images are float32 arrays (height, width) with values in [0, 1], or (height, width,
+channels) where the tracker reads colour (``with_chroma``); pixel (x, y) is column x,
 row y, with integer coordinates at pixel centres. Level l of a pyramid halves the size l
 times with ``cv2.pyrDown``, whose pixel i is centred on pixel 2i of the level below: full-
 resolution pixel p sits at p / 2**l on level l. Bilinear sampling goes through ``cv2.remap``,
@@ -195,9 +196,19 @@ def to_colour(img: np.ndarray) -> np.ndarray | None:
     return np.ascontiguousarray(img)
 
 
+def with_chroma(grey: np.ndarray, colour: np.ndarray) -> np.ndarray:
+    """The grey image (H, W) and the two chroma channels of its uint8 BGR colour (H, W, 3)
+    stacked (H, W, 3), float32: grey, then OpenCV's Cr and Cb (0.713 (R - Y) and
+    0.564 (B - Y), each about 0.5 for a grey pixel), so that a body and what lies behind it
+    that differ in hue but not in brightness differ in the image the tracker reads."""
+    ycrcb = cv2.cvtColor(colour.astype(np.float32) / 255, cv2.COLOR_BGR2YCrCb)
+    return np.dstack([grey, ycrcb[..., 1:]])
+
+
 @dataclass
 class Level:
-    """One pyramid level: the image and its x, y derivatives stacked (H, W, 3), float32."""
+    """One pyramid level: the image's C channels, then their x derivatives, then their y
+    derivatives, stacked (H, W, 3 C), float32."""
 
     stack: np.ndarray
     scale: float  # full-resolution pixels per level pixel
@@ -206,9 +217,14 @@ class Level:
     def shape(self) -> tuple[int, int]:
         return self.stack.shape[:2]
 
+    @property
+    def channels(self) -> int:
+        return self.stack.shape[2] // 3
+
 
 def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0.0) -> list[Level]:
-    """Gaussian pyramid with derivatives, finest level first; each level lightly pre-smoothed
+    """Gaussian pyramid with derivatives of a grey image (H, W) or a stack of channels
+    (H, W, C), finest level first; each level lightly pre-smoothed
     (sigma ``blur`` level pixels) so that gradients see past the sensor noise, and, when
     ``highpass`` > 0, stripped of its local mean over that sigma (level pixels) so that slow
     shading changes across a turning limb do not read as motion."""
@@ -238,14 +254,17 @@ def to_level(pixels: np.ndarray, level: Level) -> np.ndarray:
 
 
 def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Bilinear samples (N, 3) = (I, dI/dx, dI/dy) at full-resolution pixels (N, 2), with the
-    derivatives per full-resolution pixel, and a mask of points inside the image."""
+    """Bilinear samples (N, 3 C) = (I, dI/dx, dI/dy) of each of the level's C channels (the
+    channels' values, then their x derivatives, then their y derivatives) at
+    full-resolution pixels (N, 2), with the derivatives per full-resolution pixel, and a
+    mask of points inside the image."""
     p = to_level(pixels, level).astype(np.float32)
     N = len(p)
     H, W = level.shape
     inside = (p[:, 0] >= 0) & (p[:, 0] <= W - 1) & (p[:, 1] >= 0) & (p[:, 1] <= H - 1)
+    C = level.channels
     if N == 0:
-        return np.zeros((0, 3), np.float32), inside
+        return np.zeros((0, 3 * C), np.float32), inside
     cols = min(N, _REMAP_COLS)
     rows = -(-N // cols)
     maps = np.zeros((rows * cols, 2), np.float32)  # remap takes a 2-D map; pad the tail
@@ -254,5 +273,5 @@ def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                      borderMode=cv2.BORDER_REPLICATE)
     # per full-resolution pixel: the scale is a power of two, so multiplying by its inverse
     # is exact
-    per_pixel = np.array([1.0, 1 / level.scale, 1 / level.scale], np.float32)
-    return vals.reshape(-1, 3)[:N] * per_pixel, inside
+    per_pixel = np.repeat(np.array([1.0, 1 / level.scale, 1 / level.scale], np.float32), C)
+    return vals.reshape(-1, 3 * C)[:N] * per_pixel, inside

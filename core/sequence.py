@@ -21,12 +21,15 @@ class ImageSequence:
     """``images[view][frame]`` is a path or an array; grey images are float32 (H, W) in
     [0, 1], colour ones uint8 BGR (H, W, 3) (None for grey footage), pyramids finest level
     first (``core.image.pyramid``), ``levels[view]`` levels each (``levels`` given as one
-    number for every view)."""
+    number for every view), of the grey image, or with ``chroma`` of a colour frame's grey
+    and chroma channels (``core.image.with_chroma``)."""
 
-    def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0):
+    def __init__(self, images: Sequence[Sequence], levels: int, highpass: float = 0.0,
+                 chroma: bool = False):
         self.images = images
         self.levels = [levels] * len(images)
         self.highpass = highpass
+        self.chroma = chroma
         self._pyramids: dict[tuple[int, int], list[imagelib.Level]] = {}  # (view, frame)
         self._grey: dict[tuple[int, int], np.ndarray] = {}
         self._colour: dict[tuple[int, int], np.ndarray | None] = {}
@@ -45,7 +48,8 @@ class ImageSequence:
         if key not in self._pyramids:
             self._collect(frame)
         if key not in self._pyramids:
-            self._pyramids[key] = self._build(view, self.grey(view, frame))
+            self._pyramids[key] = self._build(view, self.grey(view, frame),
+                                              self.colour(view, frame))
         return self._pyramids[key]
 
     def grey(self, view: int, frame: int) -> np.ndarray:
@@ -85,7 +89,7 @@ class ImageSequence:
                                        for c in range(self.n_views)):
             return
         self._ahead[frame] = self._reader.submit(
-            lambda: [(g, rgb, self._build(c, g)) for c, (g, rgb) in
+            lambda: [(g, rgb, self._build(c, g, rgb)) for c, (g, rgb) in
                      ((c, self._read(c, frame)) for c in range(self.n_views))])
 
     def keep_only(self, keys: set[tuple[int, int]]) -> None:
@@ -107,5 +111,7 @@ class ImageSequence:
     def _read(self, view: int, frame: int) -> tuple[np.ndarray, np.ndarray | None]:
         return imagelib.grey_and_colour(self.images[view][frame])
 
-    def _build(self, view: int, grey: np.ndarray) -> list[imagelib.Level]:
-        return imagelib.pyramid(grey, self.levels[view], highpass=self.highpass)
+    def _build(self, view: int, grey: np.ndarray, colour: np.ndarray | None
+               ) -> list[imagelib.Level]:
+        img = grey if colour is None or not self.chroma else imagelib.with_chroma(grey, colour)
+        return imagelib.pyramid(img, self.levels[view], highpass=self.highpass)

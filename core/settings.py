@@ -32,6 +32,11 @@ class TrackerSettings:
                              "sparsely on added pyramid levels (faster, and steadier)")
     key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
                               "frame's: holds the track against drift")
+    colour: bool = _knob(True, "Match colour footage in its hue as well as its brightness: "
+                         "each body pixel is held to two chroma channels beside its grey "
+                         "value, each channel with its own noise level, so that cloth "
+                         "whose colours differ more than their brightness is followed "
+                         "(grey footage is not affected)")
     damping: float = _knob(1e-2, "Initial Levenberg-Marquardt damping")
     max_step: float = _knob(15.0, "Degrees any joint may turn in one iteration")
     prior: float = _knob(0.0, "Pull toward the predicted pose, relative to what the pixels "

@@ -57,24 +57,34 @@ class NormalEquations:
         self.rows += len(r)
 
 
+def squared_residual(r: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
+    """Per pixel, its residual over its noise scale squared, summed over its channels: r and
+    sigma (N,) for one channel or (N, C) for C."""
+    z = (r / sigma) ** 2
+    return z if z.ndim == 1 else z.sum(axis=1)
+
+
 def mixture_cost(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
-    """Per-pixel cost -log(exp(-r^2 / 2 sigma^2) + outlier), shifted to 0 at r = 0.
+    """Per-pixel cost -log(exp(-z / 2) + outlier), shifted to 0 at z = 0, with z the pixel's
+    ``squared_residual``: a pixel follows its blob in every channel or is an outlier in all.
 
     ``outlier`` is the flat density relative to the Gaussian's peak; a pixel that is hidden or
     off the image costs the full outlier price log((1 + outlier) / outlier)."""
-    return np.log1p(outlier) - np.log(np.exp(-0.5 * (r / sigma) ** 2) + outlier)
+    return np.log1p(outlier) - np.log(np.exp(-0.5 * squared_residual(r, sigma)) + outlier)
 
 
 def support_posterior(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
-    """Per pixel, the posterior that it follows its blob under :func:`mixture_cost`'s
+    """Per pixel (N,), the posterior that it follows its blob under :func:`mixture_cost`'s
     mixture (the EM E-step): 1 / (1 + outlier) at r = 0, toward 0 far out."""
-    g = np.exp(-0.5 * (r / sigma) ** 2)
+    g = np.exp(-0.5 * squared_residual(r, sigma))
     return g / (g + outlier)
 
 
 def support_weights(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
-    """IRLS weights of :func:`mixture_cost`: the inlier posterior over sigma^2."""
-    return support_posterior(r, sigma, outlier) / sigma**2
+    """IRLS weights of :func:`mixture_cost`, r's shape: the pixel's inlier posterior over
+    each channel's sigma^2."""
+    post = support_posterior(r, sigma, outlier)
+    return (post if np.ndim(r) == 1 else post[:, None]) / sigma**2
 
 
 def robust_scale(r: np.ndarray, floor: float) -> float:

@@ -89,3 +89,27 @@ def test_the_footage_check_names_a_jpeg_cut_short_which_the_decoder_fills_with_g
     image.check_footage(paths[:2], "view 1's footage")
     with pytest.raises(image.ImageError, match="002.jpg: cannot read this image"):
         image.check_footage(paths, "view 1's footage")
+
+
+def test_a_pyramid_of_channels_is_each_channels_pyramid_and_samples_them_all():
+    rng = np.random.default_rng(5)
+    img = cv2.GaussianBlur(rng.random((48, 64, 3)).astype(np.float32), (0, 0), 2)
+    stacked = image.pyramid(img, 3, highpass=4.0)
+    pixels = rng.uniform(0, 60, (40, 2))
+    for ch in range(3):
+        alone = image.pyramid(np.ascontiguousarray(img[..., ch]), 3, highpass=4.0)
+        for a, b in zip(stacked, alone, strict=True):
+            assert a.channels == 3 and b.channels == 1
+            np.testing.assert_allclose(a.stack[..., ch::3], b.stack, atol=1e-6)
+            both, inside = image.sample(a, pixels)
+            one, _ = image.sample(b, pixels)
+            np.testing.assert_allclose(both[:, ch::3], one, atol=1e-6)
+
+
+def test_chroma_channels_read_hue_and_are_even_for_grey():
+    bgr = np.array([[[128, 128, 128], [0, 0, 255], [255, 0, 0]]], np.uint8)
+    grey = image.to_grey(bgr)
+    out = image.with_chroma(grey, bgr)
+    np.testing.assert_array_equal(out[..., 0], grey)
+    np.testing.assert_allclose(out[0, 0, 1:], 0.5, atol=1e-6)  # grey: no hue
+    assert out[0, 1, 1] > 0.9 and out[0, 2, 2] > 0.9  # red: Cr, blue: Cb

@@ -101,3 +101,16 @@ def test_grey_footage_has_no_colour(tmp_path):
     seq = ImageSequence([[tmp_path / "grey.png", tmp_path / "as_colour.png"]], 1)
     assert seq.colour(0, 0) is None and seq.colour(0, 1) is None
     np.testing.assert_allclose(seq.grey(0, 0), seq.grey(0, 1), atol=1e-6)
+
+
+def test_chroma_pyramids_hold_grey_then_hue_and_grey_footage_stays_grey(footage, tmp_path):
+    grey_file = tmp_path / "grey.png"
+    cv2.imwrite(str(grey_file), np.full((60, 80), 90, np.uint8))
+    seq = ImageSequence([footage[0][:1], [grey_file]], 2, chroma=True)
+    colour = seq.pyramid(0, 0)
+    assert [lv.channels for lv in colour] == [3, 3]
+    plain = ImageSequence(footage, 2).pyramid(0, 0)  # its grey channel and derivatives
+    np.testing.assert_array_equal(colour[0].stack[..., ::3], plain[0].stack)
+    hue = cv2.cvtColor(cv2.imread(str(footage[0][0])), cv2.COLOR_BGR2YCrCb)[..., 1]
+    assert np.corrcoef(colour[0].stack[..., 1].ravel(), hue.ravel())[0, 1] > 0.5
+    assert [lv.channels for lv in seq.pyramid(1, 0)] == [1, 1]

@@ -8,6 +8,7 @@ from core.solver import (
     NormalEquations,
     mixture_cost,
     solve,
+    support_posterior,
     support_weights,
 )
 
@@ -98,3 +99,24 @@ def test_support_weights_are_the_irls_weights_of_the_mixture_cost():
     assert mixture_cost(np.array([0.0]), sigma, c)[0] == pytest.approx(0, abs=1e-15)
     assert support_weights(np.array([0.2]), sigma, c)[0] < 1e-3 * support_weights(
         np.array([0.0]), sigma, c)[0]
+
+
+def test_a_pixels_channels_share_one_inlier_posterior_and_each_its_own_irls_weight():
+    """A colour pixel's residuals (N, C) over their own noise scales: the cost is the
+    one-channel cost of their combined standardised residual, and support_weights times r
+    is the cost's gradient in each channel (central differences)."""
+    rng = np.random.default_rng(0)
+    r = rng.normal(0, 0.03, (50, 3))
+    sigma = np.array([0.02, 0.05, 0.01]) * np.ones((50, 1))
+    c, h = 0.1, 1e-7
+    combined = np.sqrt(np.sum((r / sigma) ** 2, 1))  # one channel with sigma 1
+    np.testing.assert_allclose(mixture_cost(r, sigma, c), mixture_cost(combined, 1.0, c),
+                               rtol=1e-12)
+    np.testing.assert_allclose(support_posterior(r, sigma, c),
+                               support_posterior(combined, 1.0, c), rtol=1e-12)
+    for ch in range(3):
+        e = np.zeros(3)
+        e[ch] = h
+        dcost = (mixture_cost(r + e, sigma, c) - mixture_cost(r - e, sigma, c)) / (2 * h)
+        np.testing.assert_allclose(support_weights(r, sigma, c)[:, ch] * r[:, ch], dcost,
+                                   atol=1e-4)

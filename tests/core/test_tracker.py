@@ -25,7 +25,7 @@ from core.side_on import (
 from core.skeleton import HINGE, human_template
 from core.solver import DegenerateSystem
 from core.tracker import Tracker, held_joints, residual_jump, track
-from support.synthetic import render, side_pinhole, side_view
+from support.synthetic import render, render_hues, side_pinhole, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
 
@@ -98,6 +98,24 @@ def test_recovers_a_known_small_motion_in_three_views(body, mode):
         for v, t in zip(est.views, moved.views):
             err = np.abs(v.project(sk.rest_positions) - t.project(sk.rest_positions)).max()
             assert err < 0.3  # pixels
+
+
+def test_cloth_that_differs_in_hue_alone_is_followed_in_colour(body):
+    """Footage whose every pixel has one brightness: its grey image is flat to rounding, and
+    only the chroma channels show the cloth move (the brightness rows alone; no
+    silhouette)."""
+    sk, pose = body
+    moved = apply_update(sk, pose, _small_motion(sk, CALIBRATED, 3, seed=4), CALIBRATED)
+    frames = [[render_hues(sk, pose, c), render_hues(sk, moved, c)] for c in range(3)]
+    before = _limb_errors(sk, pose, moved).max()
+    after = {}
+    for colour in (True, False):
+        settings = TrackerSettings(iterations=10, silhouette=0, colour=colour)
+        est = track(Tracker(sk, frames, CALIBRATED, settings), pose, [0, 1]).frames[1].pose
+        after[colour] = _limb_errors(sk, est, moved).max()
+    assert before > 2.0
+    assert after[True] < 0.5, after
+    assert after[False] > 2 * after[True] + 1.0, after
 
 
 @pytest.mark.parametrize("mode, per_level", [(CALIBRATED, 6), (INDEPENDENT, 3)])

@@ -22,25 +22,45 @@ def texture(ref: np.ndarray, seed: int = 0, wavelength: float = 0.08) -> np.ndar
     return 0.5 + 0.8 * v
 
 
-def render(skeleton, pose: BodyPose, view_index: int, shape=(360, 320), background=0.3,
-           noise=0.0, seed=0) -> np.ndarray:
-    """Render one view as a float32 grey image."""
+def _surface(skeleton, pose: BodyPose, view_index: int, shape) -> tuple[np.ndarray, np.ndarray]:
+    """Which pixels of an image of ``shape`` show the body in one view (H, W), and the
+    reference-frame points (N, 3) they show, row by row."""
     view = pose.views[view_index]
     g = skeleton.segment_motions(skeleton.joint_frames(pose.rotations, pose.root_position))
     H, W = shape
     xs, ys = np.meshgrid(np.arange(W), np.arange(H))
     pix = np.stack([xs.ravel(), ys.ravel()], 1).astype(float)
     hits = raycast.cast(view, pix, skeleton.blobs, g)
-    img = np.full(H * W, background)
     ok = hits.label >= 0
     joints = np.array([b.joint for b in skeleton.blobs])[hits.label[ok]]
     gj = g[joints]
     ref = np.einsum("nba,nb->na", gj[:, :3, :3], hits.world[ok] - gj[:, :3, 3])
-    img[ok] = texture(ref)
-    img = img.reshape(H, W)
+    return ok.reshape(H, W), ref
+
+
+def render(skeleton, pose: BodyPose, view_index: int, shape=(360, 320), background=0.3,
+           noise=0.0, seed=0) -> np.ndarray:
+    """Render one view as a float32 grey image."""
+    on, ref = _surface(skeleton, pose, view_index, shape)
+    img = np.full(shape, background)
+    img[on] = texture(ref)
     if noise:
         img = img + np.random.default_rng(seed).normal(0, noise, img.shape)
     return np.clip(img, 0, 1).astype(np.float32)
+
+
+def render_hues(skeleton, pose: BodyPose, view_index: int, shape=(360, 320)) -> np.ndarray:
+    """Render one view as uint8 BGR whose every pixel has one brightness: the body's cloth
+    differs from itself and from the grey backdrop in hue alone (two textures as its
+    chroma channels), so that a grey image of it is flat."""
+    import cv2
+
+    on, ref = _surface(skeleton, pose, view_index, shape)
+    ycrcb = np.full(shape + (3,), 0.5, np.float32)
+    ycrcb[on, 1] += 0.15 * (texture(ref, seed=1) - 0.5)
+    ycrcb[on, 2] += 0.15 * (texture(ref, seed=2) - 0.5)
+    bgr = cv2.cvtColor(np.clip(ycrcb, 0, 1), cv2.COLOR_YCrCb2BGR)
+    return np.clip(bgr * 255 + 0.5, 0, 255).astype(np.uint8)
 
 
 def side_view(scale=160.0, center=(160, 180), yaw_deg=90.0, height=0.9) -> View:
