@@ -3,10 +3,12 @@ frame, rendered through the real ray caster. Lets a test know the exact motion."
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 from core import raycast, se3
 from core.camera import Pinhole, View
+from core.image import to_uint8
 from core.pose import BodyPose
 
 
@@ -53,14 +55,12 @@ def render_hues(skeleton, pose: BodyPose, view_index: int, shape=(360, 320)) -> 
     """Render one view as uint8 BGR whose every pixel has one brightness: the body's cloth
     differs from itself and from the grey backdrop in hue alone (two textures as its
     chroma channels), so that a grey image of it is flat."""
-    import cv2
-
     on, ref = _surface(skeleton, pose, view_index, shape)
     ycrcb = np.full(shape + (3,), 0.5, np.float32)
     ycrcb[on, 1] += 0.15 * (texture(ref, seed=1) - 0.5)
     ycrcb[on, 2] += 0.15 * (texture(ref, seed=2) - 0.5)
     bgr = cv2.cvtColor(np.clip(ycrcb, 0, 1), cv2.COLOR_YCrCb2BGR)
-    return np.clip(bgr * 255 + 0.5, 0, 255).astype(np.uint8)
+    return to_uint8(bgr)
 
 
 def side_view(scale=160.0, center=(160, 180), yaw_deg=90.0, height=0.9) -> View:
