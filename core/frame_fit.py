@@ -56,6 +56,7 @@ from .side_on import BODY, TURNED, out_of_side_on
 from .skeleton import Skeleton
 from .solver import (
     NormalEquations,
+    channel_rows,
     mixture_cost,
     robust_scale,
     solve,
@@ -638,6 +639,16 @@ class FrameFit:
         return (np.repeat(ps.seg_joint[ok], C), np.repeat(world, C, axis=0),
                 grad.reshape(-1, 2), r.ravel(), self._pixel_weights(ps, ok, r, sigma).ravel())
 
+    def _solver_rows(self, ps: PointSet, sigma: np.ndarray, part: tuple) -> tuple:
+        """``_pixel_rows`` as the normal equations take them: a grey pixel's one row, a
+        colour pixel's channels as two rows that add the same (``solver.channel_rows``)."""
+        ok, world, grad, r = part
+        if r.shape[1] == 1:
+            return self._pixel_rows(ps, sigma, part)
+        joints = ps.seg_joint[ok]
+        return (np.concatenate([joints, joints]), np.concatenate([world, world]),
+                *channel_rows(grad, r, self._pixel_weights(ps, ok, r, sigma)))
+
     def _normal_equations(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
                           sigmas: list[np.ndarray], level: int) -> NormalEquations:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
@@ -646,7 +657,7 @@ class FrameFit:
         pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, X, grad, r, w)
         for ps, sigma, part in zip(sets, sigmas, smp.parts):
             if len(part[0]):
-                pieces[ps.view].append(self._pixel_rows(ps, sigma, part))
+                pieces[ps.view].append(self._solver_rows(ps, sigma, part))
         s = self.settings
         for c, pull in enumerate(smp.shape_parts):
             if pull is None or not len(pull.mm.weight):

@@ -64,6 +64,39 @@ def squared_residual(r: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
     return z if z.ndim == 1 else z.sum(axis=1)
 
 
+def channel_rows(grad: np.ndarray, r: np.ndarray, w: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Two rows a pixel that pose the same normal equations as its C channels' rows.
+
+    A channel's row is g_c^T J, J the pixel's 2 x P image Jacobian, so the channels add
+    J^T T J to A^T W A and J^T v to A^T W r, with T = sum_c w_c g_c g_c^T (the pixel's 2 x 2
+    structure tensor) and v = sum_c w_c r_c g_c: the rows l_k^T J of T's Cholesky factor
+    L = [l_1 l_2], with residuals L^-1 v and unit weights, add the same. A tensor of rank one
+    or none (gradients all along one line, or none) gives zero rows where L has no column.
+    ``grad`` (M, C, 2) each channel's gradient, ``r`` and ``w`` (M, C) its residual and
+    weight; returns gradients (2 M, 2), residuals and weights (2 M,): every pixel's first
+    row, then every pixel's second."""
+    gx, gy = grad[..., 0], grad[..., 1]
+    t00, t01, t11 = (np.sum(w * a * b, axis=1) for a, b in ((gx, gx), (gx, gy), (gy, gy)))
+    v0, v1 = np.sum(w * r * gx, axis=1), np.sum(w * r * gy, axis=1)
+    tiny = UNSEEN * float(np.max(t00 + t11, initial=0.0))  # under it a column is rounding
+    l11 = np.sqrt(np.maximum(t00, 0.0))
+    first = t00 > tiny
+    l11_or_1 = np.where(first, l11, 1.0)
+    l21 = np.where(first, t01 / l11_or_1, 0.0)
+    t22 = t11 - l21 * l21
+    second = t22 > tiny
+    l22 = np.sqrt(np.where(second, t22, 1.0))
+    rho1 = np.where(first, v0 / l11_or_1, 0.0)
+    rho2 = np.where(second, (v1 - rho1 * l21) / l22, 0.0)
+    M = len(t00)
+    out = np.zeros((2 * M, 2))
+    out[:M, 0] = np.where(first, l11, 0.0)
+    out[:M, 1] = l21
+    out[M:, 1] = np.where(second, l22, 0.0)
+    return out, np.concatenate([rho1, rho2]), np.ones(2 * M)
+
+
 def mixture_cost(r: np.ndarray, sigma: float | np.ndarray, outlier: float) -> np.ndarray:
     """Per-pixel cost -log(exp(-z / 2) + outlier), shifted to 0 at z = 0, with z the pixel's
     ``squared_residual``: a pixel follows its blob in every channel or is an outlier in all.

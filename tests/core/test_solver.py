@@ -6,6 +6,7 @@ import pytest
 from core.solver import (
     DegenerateSystem,
     NormalEquations,
+    channel_rows,
     mixture_cost,
     solve,
     support_posterior,
@@ -120,3 +121,31 @@ def test_a_pixels_channels_share_one_inlier_posterior_and_each_its_own_irls_weig
         dcost = (mixture_cost(r + e, sigma, c) - mixture_cost(r - e, sigma, c)) / (2 * h)
         np.testing.assert_allclose(support_weights(r, sigma, c)[:, ch] * r[:, ch], dcost,
                                    atol=1e-4)
+
+
+def _normal_equations_of(rows: np.ndarray, r: np.ndarray, w: np.ndarray) -> NormalEquations:
+    ne = NormalEquations.zeros(rows.shape[1])
+    ne.add(rows, r, w)
+    return ne
+
+
+def test_two_rows_a_pixel_pose_its_channels_normal_equations():
+    """Each pixel's C channel rows g_c^T J (J its own 2 x P image Jacobian) against the two
+    rows ``channel_rows`` gives it, through the same J: the same A^T W A and A^T W r. Among
+    the pixels, one whose channels' gradients all lie along one line and one with none."""
+    rng = np.random.default_rng(3)
+    M, C, P = 40, 3, 7
+    J = rng.normal(size=(M, 2, P))
+    grad = rng.normal(size=(M, C, 2))
+    grad[1] = np.outer([1.0, -2.0, 0.5], [0.6, 0.8])  # rank one
+    grad[2] = 0.0  # no gradient
+    r, w = rng.normal(size=(M, C)), rng.uniform(0.1, 2.0, size=(M, C))
+    channels = _normal_equations_of(np.einsum("mck,mkp->mcp", grad, J).reshape(-1, P),
+                                    r.ravel(), w.ravel())
+    g2, r2, w2 = channel_rows(grad, r, w)
+    assert g2.shape == (2 * M, 2) and r2.shape == w2.shape == (2 * M,)
+    two = _normal_equations_of(np.einsum("nk,nkp->np", g2, np.concatenate([J, J])), r2, w2)
+    np.testing.assert_allclose(two.H, channels.H, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(two.b, channels.b, rtol=1e-10, atol=1e-10)
+    assert not g2[2].any() and not g2[M + 2].any() and r2[2] == r2[M + 2] == 0
+    assert not g2[M + 1].any()  # the rank-one pixel's second row
