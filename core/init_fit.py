@@ -71,7 +71,9 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
              fit_lengths: bool = True) -> FitResult:
     """Fit pose (and lengths) to ``clicks`` (per view: point name -> (x, y) pixels; a point
     is a joint, or ``"<joint>/end"``, the tip of that joint's first end site: a foot or a
-    hoof that ends a limb, whose length the fit keeps)."""
+    hoof that ends a limb, whose length the fit keeps). A hinge the clicks leave bent
+    against its limits under its parent twisted half a turn comes back as the same body
+    within them (``Skeleton.untwisted``)."""
     if len(clicks) != len(guess.views):
         raise FitError(f"clicks for {len(clicks)} views, but {len(guess.views)} views")
     points = []  # per view, each click's (joint, whether at its end site)
@@ -174,6 +176,7 @@ def fit_pose(sk: Skeleton, guess: BodyPose, clicks: list[dict], mode: str,
     fitted = Skeleton(sk.names, sk.parents, offsets, sk.kinds, sk.axes, sk.end_sites,
                       limits=sk.limits, hinge_zero=sk.hinge_zero)
     fitted.blobs = fitted.default_blobs()
+    R = sk.untwisted(R)  # a hinge bent against its limits under a parent twisted half a turn
     n_clicks = sum(len(v) for v in clicks)
     rms = float(np.sqrt(np.sum(sol.fun[:2 * n_clicks] ** 2) / max(n_clicks, 1)))
     return FitResult(fitted, BodyPose(R, root, [v.copy() for v in views]), rms,

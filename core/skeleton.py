@@ -181,6 +181,52 @@ class Skeleton:
         lo, hi = self.limits[j]
         return min(lo, theta) - theta, max(hi, theta) - theta
 
+    def untwisted(self, rotations: np.ndarray) -> np.ndarray:
+        """``rotations`` (J, 3, 3), a copy, with each limited hinge that is bent outside its
+        limits under a parent ball twisted over a quarter turn about the bone between them
+        turned back: the parent turned half a turn about that bone and the hinge bent the
+        other way. A thigh twisted half a turn over a knee bent forward puts every joint and
+        blob where the untwisted thigh over the knee bent backward does (clicks cannot tell
+        them apart), but only the second is within the knee's limits, and a tracked hinge
+        outside its limits can only straighten. Kept only where the hinge ends within its
+        limits and every joint, end site and blob stays where it was."""
+        out = np.array(rotations, float)
+        for j in range(self.n_joints):
+            p = int(self.parents[j])
+            if not self.limited_hinge(j) or p < 0 or self.kinds[p] != BALL:
+                continue
+            lo, hi = self.limits[j]
+            if lo <= self.hinge_angle(j, out[j]) <= hi:
+                continue
+            bone = self.offsets[j] / max(float(np.linalg.norm(self.offsets[j])), 1e-12)
+            if abs(twist_about(out[p], bone)) <= np.pi / 2:
+                continue  # turning it half a turn would twist the parent more, not less
+            half = se3.exp_so3(np.pi * bone)  # half a turn about the bone, in p's frame
+            cand = out.copy()
+            cand[p] = out[p] @ half
+            cand[j] = half.T @ out[j] @ half
+            for c in self.children(j):
+                cand[c] = half.T @ out[c]
+            if lo <= self.hinge_angle(j, cand[j]) <= hi and self.same_body(out, cand):
+                out = cand
+        return out
+
+    def same_body(self, a: np.ndarray, b: np.ndarray, tol: float = 1e-9) -> bool:
+        """Whether local rotations ``a`` and ``b`` (J, 3, 3) put every joint, end site and
+        blob (its centre and its shape) in the same place, to ``tol`` of the body's height."""
+        places = []
+        for R in (a, b):
+            M = self.joint_frames(R, np.zeros(3))
+            g = self.segment_motions(M)
+            ends = [M[j, :3, :3] @ e + M[j, :3, 3] for j, es in enumerate(self.end_sites)
+                    for e in es]
+            # each blob's centre, and its quadric's matrix scaled by its least radius squared
+            blobs = [np.concatenate([g[b.joint, :3, :3] @ b.centre + g[b.joint, :3, 3], (
+                g[b.joint, :3, :3] @ b.Q @ np.diag((b.radii.min() / b.radii) ** 2) @ b.Q.T
+                @ g[b.joint, :3, :3].T).ravel()]) for b in self.blobs]
+            places.append(np.concatenate([M[:, :3, 3].ravel(), np.ravel(ends)] + blobs))
+        return bool(np.allclose(places[0], places[1], rtol=0, atol=tol * self.height()))
+
     def tracked_joint_names(self) -> list[str]:
         """Names of the joints that turn (ball or hinge), parents first."""
         return [n for n, kind in zip(self.names, self.kinds) if kind in (BALL, HINGE)]
@@ -294,6 +340,15 @@ def skeleton_from_bvh(bvh: BvhFile) -> Skeleton:
         offsets=np.array([j.offset for j in bvh.joints]),
         end_sites=[list(j.end_sites) for j in bvh.joints],
     )
+
+
+def twist_about(R: np.ndarray, axis: np.ndarray) -> float:
+    """The angle (radians, in [-pi, pi]) of rotation R's twist about the unit ``axis``: R is
+    a swing that moves the axis after that twist (the swing-twist split)."""
+    r = se3.log_so3(R)  # angle times unit axis: the quaternion (cos(a/2), sin(a/2) n)
+    angle = float(np.linalg.norm(r))
+    along = float(r @ axis) / angle if angle > 1e-12 else 0.0
+    return float(2 * np.arctan2(np.sin(angle / 2) * along, np.cos(angle / 2)))
 
 
 # --- templates -------------------------------------------------------------------------

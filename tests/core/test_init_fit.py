@@ -10,7 +10,7 @@ from core.bvh import read_bvh
 from core.camera import Pinhole, View
 from core.init_fit import FitError, fit_pose, least_certain, symmetry_key
 from core.pose import CALIBRATED, INDEPENDENT, BodyPose
-from core.skeleton import BALL, HINGE, Skeleton, skeleton_from_bvh
+from core.skeleton import BALL, HINGE, Skeleton, human_template, skeleton_from_bvh, twist_about
 
 JOINTS = {"LeftHip": BALL, "RightHip": BALL, "LeftShoulder": BALL, "RightShoulder": BALL,
           "Neck": BALL, "LeftKnee": (HINGE, [0.94, 0.34, 0]),
@@ -371,3 +371,33 @@ def test_the_tips_of_limbs_pin_the_bones_that_end_in_them():
     with pytest.raises(FitError, match="'Trunk' has no end site"):
         fit_pose(sk, guess, [{**clicks, "Trunk/end": (0.0, 0.0)}], CALIBRATED,
                  fit_lengths=False)
+
+
+def test_a_knee_fitted_bent_forward_under_a_thigh_twisted_half_a_turn_comes_back_untwisted():
+    # the guess's thigh twisted half a turn: the clicks of a knee bent 40 degrees are met
+    # as well by that thigh over the knee bent forward, outside the knee's limits, where a
+    # tracker could only straighten it; the fit returns the same body within them
+    sk = human_template()
+    knee, hip = sk.index("LeftKnee"), sk.index("LeftHip")
+    along = sk.offsets[knee] / np.linalg.norm(sk.offsets[knee])
+    R_true = np.repeat(np.eye(3)[None], sk.n_joints, 0)
+    R_true[hip] = se3.exp_so3(np.radians([-25.0, 0, 5]))
+    R_true[knee] = se3.exp_so3(np.radians(40.0) * sk.axes[knee])
+    p = np.array([0.3, 0.0, -1.5])
+    views = _views(3)
+    X = sk.world_positions(R_true, p)
+    names = ["Hips", "LeftHip", "LeftKnee", "RightHip", "RightKnee", "LeftShoulder",
+             "RightShoulder", "LeftElbow", "RightElbow", "Neck"]
+    clicks = [{n: v.project(X[sk.index(n)]) for n in names} | {
+        f"{n}/end": v.project(sk.joint_frames(R_true, p)[sk.index(n), :3, :3]
+                              @ sk.end_sites[sk.index(n)][0]
+                              + sk.joint_frames(R_true, p)[sk.index(n), :3, 3])
+        for n in ("LeftKnee", "RightKnee", "LeftElbow", "RightElbow", "Neck")} for v in views]
+    R_guess = R_true.copy()
+    R_guess[hip] = R_true[hip] @ se3.exp_so3(np.radians(175.0) * along)
+    R_guess[knee] = np.eye(3)
+    res = fit_pose(sk, BodyPose(R_guess, p, views), clicks, CALIBRATED, fit_lengths=False)
+    assert res.residual_px < 0.5
+    R = res.pose.rotations
+    assert np.degrees(sk.hinge_angle(knee, R[knee])) == pytest.approx(40, abs=1)
+    assert abs(np.degrees(twist_about(R[hip], along))) < 10

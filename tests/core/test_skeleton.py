@@ -14,6 +14,7 @@ from core.skeleton import (
     planar_chain_template,
     planar_quadruped_template,
     skeleton_from_bvh,
+    twist_about,
     walker_template,
 )
 
@@ -170,3 +171,75 @@ def test_the_tracked_joints_are_those_with_degrees_of_freedom_in_joint_order():
     want = [sk.names[j] for j in sorted(set(dof_joints.tolist()))]
     assert sk.tracked_joint_names() == want
     assert len(want) == 9 and "LeftKnee" in want and sk.names[0] not in want
+
+
+def _leg_pose(sk, thigh_twist, knee):
+    """Rest rotations with the left thigh swung a little, then twisted ``thigh_twist`` about
+    its bone, and the left knee at ``knee`` (radians)."""
+    R = np.repeat(np.eye(3)[None], sk.n_joints, 0)
+    along = sk.offsets[sk.index("LeftKnee")] / np.linalg.norm(sk.offsets[sk.index("LeftKnee")])
+    R[sk.index("LeftHip")] = se3.exp_so3(np.array([0.3, 0.2, 0.1])) @ se3.exp_so3(
+        thigh_twist * along)
+    R[sk.index("LeftKnee")] = se3.exp_so3(knee * sk.axes[sk.index("LeftKnee")])
+    return R
+
+
+def _places(sk, R):
+    """Every joint and end site, in the world."""
+    M = sk.joint_frames(R, np.zeros(3))
+    return np.vstack([M[:, :3, 3]] + [M[j, :3, :3] @ e + M[j, :3, 3]
+                                      for j, es in enumerate(sk.end_sites) for e in es])
+
+
+def test_a_hinge_bent_against_its_limits_under_a_parent_twisted_half_a_turn_is_untwisted():
+    sk = human_template()
+    knee, hip = sk.index("LeftKnee"), sk.index("LeftHip")
+    along = sk.offsets[knee] / np.linalg.norm(sk.offsets[knee])
+    R = _leg_pose(sk, np.radians(170), np.radians(-40))  # knee bent forward: outside 0..160
+    U = sk.untwisted(R)
+    assert np.degrees(sk.hinge_angle(knee, U[knee])) == pytest.approx(40)
+    assert abs(np.degrees(twist_about(U[hip], along))) < 90  # the thigh no longer twisted
+    np.testing.assert_allclose(_places(sk, U), _places(sk, R), atol=1e-12)
+    # every blob is the same ellipsoid: any world point lies as far inside or out of it
+    g_r, g_u = (sk.segment_motions(sk.joint_frames(R_, np.zeros(3))) for R_ in (R, U))
+    x = np.random.default_rng(1).normal(0, 0.5, (50, 3))
+    for b in sk.blobs:
+        level = [np.linalg.norm((np.linalg.solve(g[b.joint][:3, :3], (x - g[b.joint][:3, 3]).T).T
+                                 - b.centre) @ b.Q / b.radii, axis=1) for g in (g_r, g_u)]
+        np.testing.assert_allclose(level[0], level[1], atol=1e-9)
+    assert sk.same_body(R, U)
+    untouched = [j for j in range(sk.n_joints) if j not in (knee, hip)]
+    np.testing.assert_array_equal(U[untouched], R[untouched])
+
+
+def test_a_hinge_outside_its_limits_under_an_untwisted_parent_is_left_as_it_is():
+    sk = human_template()
+    # a knee locked a little past straight: turning the thigh half a turn would put the knee
+    # within its limits but twist the thigh, and the next bend would go the wrong way
+    R = _leg_pose(sk, np.radians(10), np.radians(-5))
+    np.testing.assert_array_equal(sk.untwisted(R), R)
+    R = _leg_pose(sk, np.radians(170), np.radians(30))  # within its limits: nothing to do
+    np.testing.assert_array_equal(sk.untwisted(R), R)
+
+
+def test_a_blob_off_its_bone_keeps_the_parent_twisted():
+    sk = human_template()
+    hip = sk.index("LeftHip")
+    thigh = next(b for b in sk.blobs if b.joint == hip)
+    thigh.centre = thigh.centre + np.array([0.05, 0, 0])  # a thigh blob beside its bone
+    R = _leg_pose(sk, np.radians(170), np.radians(-40))
+    assert not sk.same_body(R, _leg_pose(sk, np.radians(-10), np.radians(40)))
+    np.testing.assert_array_equal(sk.untwisted(R), R)
+
+
+def test_twist_about_is_the_quaternions_twist():
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        w = rng.normal(size=3)
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        R = se3.exp_so3(w)
+        tau = twist_about(R, axis)
+        # the swing left after taking the twist out moves the axis and turns nothing about it
+        swing = R @ se3.exp_so3(-tau * axis)
+        assert abs(se3.log_so3(swing) @ axis) < 1e-9
