@@ -181,6 +181,12 @@ class Skeleton:
         lo, hi = self.limits[j]
         return min(lo, theta) - theta, max(hi, theta) - theta
 
+    def outside_limits(self, rotations: np.ndarray) -> list[str]:
+        """The limited hinges that ``rotations`` (J, 3, 3) bend outside their limits."""
+        return [self.names[j] for j in range(self.n_joints) if self.limited_hinge(j)
+                and not self.limits[j][0] <= self.hinge_angle(j, rotations[j])
+                <= self.limits[j][1]]
+
     def untwisted(self, rotations: np.ndarray) -> np.ndarray:
         """``rotations`` (J, 3, 3), a copy, with each limited hinge that is bent outside its
         limits under a parent ball twisted over a quarter turn about the bone between them

@@ -230,6 +230,13 @@ class Tracker(FrameFit):
                 "away from the camera unseen (only foreshortening shows it): add a view from "
                 "another side, or track side-on, as hinges about the line of sight (Side on "
                 "in the Track settings; side_on in a job)")
+        outside = self.skeleton.outside_limits(initial.rotations)
+        if outside:
+            self.notes.append(
+                f"{', '.join(outside)} start{'s' if len(outside) == 1 else ''} bent outside "
+                "the joint's limits and can only turn back toward them: pose "
+                f"{'it' if len(outside) == 1 else 'them'} within the limits (Fit Pose to "
+                "Markers and core fit do) to let the tracker follow every bend")
         self.scale_to(initial)
         first = FrameResult(frame=key_frame, pose=initial.copy(), residual=0.0, iterations=0,
                             converged=True, given=True)

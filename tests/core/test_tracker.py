@@ -864,3 +864,15 @@ def test_tracked_side_on_a_limb_in_doubt_is_predicted_where_it_was():
     assert sorted(held_joints(prev, side_on=True)) == ["LeftElbow", "LeftHip", "Neck",
                                                         "RightElbow"]
     assert sorted(held_joints(prev, side_on=False)) == ["LeftElbow", "Neck"]
+
+
+def test_a_note_names_the_hinges_that_start_outside_their_limits():
+    sk = human_template()
+    knee = sk.index("LeftKnee")
+    pose = BodyPose(np.tile(np.eye(3), (sk.n_joints, 1, 1)), sk.rest_positions[0].copy(),
+                    [v.copy() for v in VIEWS])
+    frames = [[render(sk, pose, c)] * 2 for c in range(3)]
+    assert track(Tracker(sk, frames, CALIBRATED), pose, [0, 1]).notes == []
+    pose.rotations[knee] = se3.exp_so3(np.radians(-20) * sk.axes[knee])  # bent forward
+    notes = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1]).notes
+    assert len(notes) == 1 and notes[0].startswith("LeftKnee starts bent outside")
