@@ -43,7 +43,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
-from suite import settings_digest  # noqa: E402
+from suite import BAD_LIMB_DEG, flag_counts, settings_digest, share  # noqa: E402
 
 from core import raycast  # noqa: E402
 from core.bvh import BvhFile, BvhJoint, read_bvh, write_bvh  # noqa: E402
@@ -66,6 +66,13 @@ POINTS = {"LeftShoulder": 11, "RightShoulder": 12, "LeftElbow": 13, "RightElbow"
           "LeftKnee": 25, "RightKnee": 26, "LeftKnee/end": 27, "RightKnee/end": 28}
 SWAP = {name: name.replace("Left", "Right") if "Left" in name else name.replace("Right", "Left")
         for name in POINTS}
+# the template's eight limbs (label, from, to), as the suite scores its flags on them
+LIMBS = [("left thigh", "LeftHip", "LeftKnee"), ("right thigh", "RightHip", "RightKnee"),
+         ("left shank", "LeftKnee", "LeftKnee/end"), ("right shank", "RightKnee", "RightKnee/end"),
+         ("left upper arm", "LeftShoulder", "LeftElbow"),
+         ("right upper arm", "RightShoulder", "RightElbow"),
+         ("left forearm", "LeftElbow", "LeftElbow/end"),
+         ("right forearm", "RightElbow", "RightElbow/end")]
 
 
 def template_bvh(sk: Skeleton) -> BvhFile:
@@ -198,6 +205,20 @@ def _means(distances: tuple[np.ndarray, ...]) -> tuple[float, ...]:
                  for d in distances)
 
 
+def flag_line(sk: Skeleton, rep: dict, tracked: list, floor: list) -> str:
+    """The report's limb flags read against each frame fitted to its own landmarks (the
+    nearest to a truth the clip has), as the suite reads them against the capture
+    (``suite.flag_counts``): how many of the limbs over ``BAD_LIMB_DEG`` off that fit are
+    flagged, and how many of the flags are on such limbs. ``tracked`` and ``floor``: per
+    frame (rotations, root)."""
+    est, truth = ((np.array([R for R, _ in poses]), np.array([p for _, p in poses]))
+                  for poses in (tracked, floor))
+    caught, bad, flagged = flag_counts(rep, sk, est, truth, LIMBS)
+    return (f"Flags against each frame fitted to its landmarks: {share(caught, bad)} of the "
+            f"{bad} limbs over {BAD_LIMB_DEG:g}° off that fit flagged, {share(caught, flagged)} "
+            f"of the {flagged} flags on such limbs.")
+
+
 def fitted_each_frame(sk: Skeleton, poses: list, cams, views, mode: str, landmarks: np.ndarray,
                       visibility: np.ndarray) -> list:
     """Every frame's pose fitted to that frame's own landmarks, the body's proportions as
@@ -259,6 +280,7 @@ def run(frames: int = 100, lower_back: bool = True, sheet: Path | None = None,
         n = len(tracked)
         contact_sheet(fsk, tracked, cams, [0, n // 2, n - 1], sheet)
     lines = _table(e_track, e_still, e_floor, rep, fit_log, seconds, lower_back)
+    lines += ["", flag_line(fsk, rep, tracked, floor)]
     if points:
         lines += [""] + point_table(fsk, tracked, floor, cams, landmarks, visibility)
     if starts > 1:

@@ -289,7 +289,8 @@ def over_starts(runs: list[dict]) -> dict:
     return row
 
 
-def _share(part: int, whole: int) -> str:
+def share(part: int, whole: int) -> str:
+    """``part`` of ``whole`` in whole percent ('-' of none)."""
     return f"{100 * part / whole:.0f} %" if whole else "-"
 
 
@@ -322,7 +323,7 @@ def table(rows: dict, runs: list[str]) -> list[str]:
             f" {sum(r['tracker'] < r['still'] for r in rs)}/{len(rs)} |"
             f" {sum(r['stopped'] for r in rs)} of {sum(r['starts'] for r in rs)} runs |"
             f" {f'{statistics.median(img):.1f} %' if img else ''} |"
-            f" {_share(caught, bad)} of {bad} | {_share(caught, flagged)} of {flagged} |"
+            f" {share(caught, bad)} of {bad} | {share(caught, flagged)} of {flagged} |"
             f" {statistics.median(r['fps'] for r in rs):.1f} |"
             f" {max(r['peak_mb'] for r in rs):.0f} MB |")
     return out

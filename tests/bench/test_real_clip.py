@@ -83,3 +83,26 @@ def test_the_starts_line_reads_each_starts_drift_as_its_own_last_five_over_its_f
     assert "first five 1.5 (1.0-2.0)" in line
     assert "last five 3.5 (3.0-4.0)" in line
     assert "last five over first five 2.75 (1.50-4.00)x" in line
+
+
+def test_the_flags_are_read_against_each_frames_landmark_fit_limb_by_limb():
+    # three frames; the fit's left forearm 30 degrees off the track on frames 1 and 2, its
+    # right thigh 5 degrees off on frame 2; the report flags the left elbow's segment on
+    # frame 1 (right) and the right hip's on frame 2 (a flag on a limb near the fit)
+    sk = human_template(lower_back=True)
+    rest = (np.tile(np.eye(3), (sk.n_joints, 1, 1)), np.zeros(3))
+    tracked = [(rest[0].copy(), rest[1]) for _ in range(3)]
+    floor = [(R.copy(), p) for R, p in tracked]
+    elbow, hip = sk.index("LeftElbow"), sk.index("RightHip")
+    for f in (1, 2):
+        floor[f][0][elbow] = se3.exp_so3(np.radians(30.0) * np.array([1.0, 0, 0]))
+    floor[2][0][hip] = se3.exp_so3(np.radians(5.0) * np.array([1.0, 0, 0]))
+    names = ["Spine", "Neck", "LeftShoulder", "LeftElbow", "RightShoulder", "RightElbow",
+             "LeftHip", "LeftKnee", "RightHip", "RightKnee"]
+    flags = {1: "LeftElbow", 2: "RightHip"}
+    rep = {"frames": [{"frame": 0, "limbs": None}] + [
+        {"frame": f, "limbs": {n: {"flag": "unsure" if flags[f] == n else ""} for n in names}}
+        for f in (1, 2)]}
+    line = real_clip.flag_line(sk, rep, tracked, floor)
+    assert "50 % of the 2 limbs over 20° off that fit flagged" in line
+    assert "50 % of the 2 flags on such limbs" in line
