@@ -181,11 +181,15 @@ class Skeleton:
         lo, hi = self.limits[j]
         return min(lo, theta) - theta, max(hi, theta) - theta
 
+    def within_limits(self, j: int, rotation: np.ndarray) -> bool:
+        """Whether hinge j's angle in local ``rotation`` lies within its limits."""
+        lo, hi = self.limits[j]
+        return bool(lo <= self.hinge_angle(j, rotation) <= hi)
+
     def outside_limits(self, rotations: np.ndarray) -> list[str]:
         """The limited hinges that ``rotations`` (J, 3, 3) bend outside their limits."""
-        return [self.names[j] for j in range(self.n_joints) if self.limited_hinge(j)
-                and not self.limits[j][0] <= self.hinge_angle(j, rotations[j])
-                <= self.limits[j][1]]
+        return [self.names[j] for j in range(self.n_joints)
+                if self.limited_hinge(j) and not self.within_limits(j, rotations[j])]
 
     def untwisted(self, rotations: np.ndarray) -> np.ndarray:
         """``rotations`` (J, 3, 3), a copy, with each limited hinge that is bent outside its
@@ -201,8 +205,7 @@ class Skeleton:
             p = int(self.parents[j])
             if not self.limited_hinge(j) or p < 0 or self.kinds[p] != BALL:
                 continue
-            lo, hi = self.limits[j]
-            if lo <= self.hinge_angle(j, out[j]) <= hi:
+            if self.within_limits(j, out[j]):
                 continue
             bone = self.offsets[j] / max(float(np.linalg.norm(self.offsets[j])), 1e-12)
             if abs(twist_about(out[p], bone)) <= np.pi / 2:
@@ -213,7 +216,7 @@ class Skeleton:
             cand[j] = half.T @ out[j] @ half
             for c in self.children(j):
                 cand[c] = half.T @ out[c]
-            if lo <= self.hinge_angle(j, cand[j]) <= hi and self.same_body(out, cand):
+            if self.within_limits(j, cand[j]) and self.same_body(out, cand):
                 out = cand
         return out
 
