@@ -43,6 +43,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
+from captures import LIMB_ROLES  # noqa: E402
 from suite import BAD_LIMB_DEG, flag_counts, settings_digest, share  # noqa: E402
 
 from core import raycast  # noqa: E402
@@ -66,13 +67,13 @@ POINTS = {"LeftShoulder": 11, "RightShoulder": 12, "LeftElbow": 13, "RightElbow"
           "LeftKnee": 25, "RightKnee": 26, "LeftKnee/end": 27, "RightKnee/end": 28}
 SWAP = {name: name.replace("Left", "Right") if "Left" in name else name.replace("Right", "Left")
         for name in POINTS}
-# the template's eight limbs (label, from, to), as the suite scores its flags on them
-LIMBS = [("left thigh", "LeftHip", "LeftKnee"), ("right thigh", "RightHip", "RightKnee"),
-         ("left shank", "LeftKnee", "LeftKnee/end"), ("right shank", "RightKnee", "RightKnee/end"),
-         ("left upper arm", "LeftShoulder", "LeftElbow"),
-         ("right upper arm", "RightShoulder", "RightElbow"),
-         ("left forearm", "LeftElbow", "LeftElbow/end"),
-         ("right forearm", "RightElbow", "RightElbow/end")]
+# the template's joint (or end site) for each of the suite's limb roles, and so its eight
+# limbs (label, from, to), as the suite scores its flags on them
+ROLES = {f"{role}.{side[0]}": f"{side}{joint}" for side in ("Left", "Right")
+         for role, joint in (("thigh", "Hip"), ("shank", "Knee"), ("foot", "Knee/end"),
+                             ("upper_arm", "Shoulder"), ("forearm", "Elbow"),
+                             ("hand", "Elbow/end"))}
+LIMBS = [(label, ROLES[a], ROLES[b]) for label, a, b in LIMB_ROLES]
 
 
 def template_bvh(sk: Skeleton) -> BvhFile:
