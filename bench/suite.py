@@ -2,7 +2,8 @@
 and scored against the capture beside two references on the same frames.
 
     python bench/suite.py [--quick] [--bandai-namco FOLDER] [--settings JSON] [--starts N]
-                          [--clips NAME,...] [--looks NAME,...] [--workers N] [--write PATH]
+                          [--clips NAME,...] [--looks NAME,...] [--half-size] [--workers N]
+                          [--write PATH]
 
 Each clip (a capture of ``captures.NAMINGS``) is rendered once per look
 (``suite_footage.LOOKS``) into ``.cache/suite/``, ``--workers`` looks at once, and tracked
@@ -22,7 +23,8 @@ once the footage is rendered): the CMU clips at 15 fps, from the first frame alo
 Bandai Namco clips are non-commercial and never stored in the repository: give the folder
 that holds them (``bn_*.bvh``) to include them. Two renderers, then two trackers, run at
 once, one per core of a two-core machine; the tracking speed of a run alone, as a user's, is
-``--workers 1`` (nothing else running).
+``--workers 1`` (nothing else running). ``--half-size`` tracks every run on its footage
+halved (``suite_footage.halve_job``): the body about 100 pixels tall instead of 205.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ from suite_footage import (  # noqa: E402
     VIEWS,
     Clip,
     frame_ext,
+    halve_job,
     look_cameras,
     look_rendered,
     render_look,
@@ -95,6 +98,7 @@ RUNS = {
 DEFAULT_RUNS = ("3 views 15 fps", "1 lateral view 15 fps", "3 views 30 fps",
                 "1 lateral view 30 fps")
 QUICK_RUNS = ("3 views 15 fps", "1 lateral view 15 fps")
+HALF_LABEL = ", half size"  # after a look's name in the tables, with ``--half-size``
 
 
 def slug(text: str) -> str:
@@ -242,9 +246,9 @@ def tracked_and_true(job_path: Path, run: str, start: int = 0) -> tuple:
     return job, limbs, est, truth
 
 
-def score_run(job_path: Path, run: str, start: int = 0) -> dict:
-    """Track one job (of ``write_job``, from ``start``) and score it beside the references
-    of its clip and run."""
+def score_run(job_path: Path, run: str, start: int = 0, size: float = 1.0) -> dict:
+    """Track one job (of ``write_job``, from ``start``, on footage ``size`` times the
+    rendered one's) and score it beside the references of its clip and run."""
     views = RUNS[run][0]
     out = job_path.with_suffix(".bvh")
     rep_path = job_path.with_suffix(".report.json")
@@ -263,7 +267,7 @@ def score_run(job_path: Path, run: str, start: int = 0) -> dict:
            "heading": float(np.mean(np.abs(evaluate.heading_errors_deg(
                np.asarray(est[0])[:, 0], np.asarray(truth[0])[:, 0]))))}
     if len(views) == 1:
-        height_px = sk.height() * PIXELS_PER_METRE
+        height_px = sk.height() * PIXELS_PER_METRE * size
         px = evaluate.image_error_px(sk, est, truth, [m or c for c, m in zip(
             job.cameras, job.moving)], limbs)
         row["image_pct"] = 100 * px / height_px
@@ -385,6 +389,8 @@ def main(argv=None) -> int:
                     "(their jobs and tracked files named apart from the defaults')")
     ap.add_argument("--starts", type=int, help="starting frames each clip, look and run is "
                     "tracked from, its scores averaged (default 3, or 1 with --quick)")
+    ap.add_argument("--half-size", action="store_true",
+                    help="track on the footage halved in size (the body about 100 pixels tall)")
     ap.add_argument("--workers", type=int, default=2,
                     help="renderers, then trackers, run at once (default 2, one per core; 1 "
                     "for a tracker's speed alone)")
@@ -409,15 +415,20 @@ def main(argv=None) -> int:
     for clip in clips:
         stage(clip, CACHE / slug(clip.name))
     render_missing(clips, looks, a.workers, t0)
+    size = 0.5 if a.half_size else 1.0
     for clip in clips:
         clip_dir = CACHE / slug(clip.name)
         for look in looks:
-            jobs += [((clip.name, look, run), k, write_job(clip_dir, look, run, settings, k))
-                     for run in runs for k in range(starts)]
+            for run in runs:
+                for k in range(starts):
+                    job = write_job(clip_dir, look, run, settings, k)
+                    if a.half_size:
+                        job = halve_job(job)
+                    jobs.append(((clip.name, look + HALF_LABEL * a.half_size, run), k, job))
     scored: dict[tuple, list[dict]] = {}
     with ThreadPoolExecutor(a.workers) as pool:  # each tracker uses one BLAS thread
         for (key, k, _), row in zip(jobs, pool.map(
-                lambda j: score_run(j[2], j[0][2], j[1]), jobs)):
+                lambda j: score_run(j[2], j[0][2], j[1], size), jobs)):
             scored.setdefault(key, []).append(row)
             print(f"{' / '.join(key)} from frame {k}: {row['tracker']:.1f}° (held still "
                   f"{row['still']:.1f}, best fit {row['best']:.1f}), "
@@ -431,7 +442,9 @@ def main(argv=None) -> int:
         head = [
             "# Benchmark results", "",
             f"Written by `{command_line(argv)}` on {time.strftime('%Y-%m-%d')}. Each clip is two "
-            "seconds of real motion capture rendered in each look and tracked with "
+            "seconds of real motion capture rendered in each look"
+            f"{', halved in size (the body about 100 pixels tall),' if a.half_size else ''}"
+            " and tracked with "
             f"{settings_phrase(settings)} and the default blobs, from each of its first {starts} "
             "frame(s) (posed there by the capture): tracking is chaotic, so *tracker* is the "
             "mean over those runs, with the lowest and highest beside it. *tracker*, *held "

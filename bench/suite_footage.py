@@ -174,6 +174,54 @@ def turned_backdrop(back: np.ndarray, K: np.ndarray, R0: np.ndarray, R: np.ndarr
     return cv2.warpPerspective(np.tile(back, (3, 3, 1)), H, (w, h), flags=cv2.INTER_LINEAR)
 
 
+HALF = "_half"  # after a look's name: its footage and jobs at half the size (``halve_job``)
+
+
+def halved_camera(cam: dict) -> dict:
+    """A job's camera (``job_camera``, ``pinhole_job_camera``) on its footage halved: pixel
+    p (centres at integers) becomes (p + 0.5) / 2 - 0.5, as a camera twice as far, or with
+    half the focal length, would show the body."""
+    out = dict(cam)
+    if cam["model"] == "scaled_orthographic":
+        out["scale"] = cam["scale"] / 2
+        out["center"] = [(c + 0.5) / 2 - 0.5 for c in cam["center"]]
+    else:
+        K = np.array(cam["K"], float)
+        K[:2, :2] /= 2
+        K[:2, 2] = (K[:2, 2] + 0.5) / 2 - 0.5
+        out["K"] = K.tolist()
+    return out
+
+
+def halve_job(job_path: Path) -> Path:
+    """The suite job ``job_path`` (``<look>__<run>...json``, its images under ``<look>/``) on
+    its footage halved in size: every image's 2 x 2 pixels averaged into
+    ``<look>_half/`` beside it (once), the cameras with it (``halved_camera``); the job
+    written as ``<look>_half__<run>...json``. A body 100 pixels tall instead of 205, as a
+    wide shot or a far camera shows one."""
+    import cv2
+
+    look, rest = job_path.name.split("__", 1)
+    job = json.loads(job_path.read_text())
+    for view in job["views"]:
+        view["camera"] = halved_camera(view["camera"])
+        halves = []
+        for image in view["images"]:
+            half = Path(look + HALF, *Path(image).parts[1:])
+            target = job_path.parent / half
+            if not target.exists():
+                target.parent.mkdir(parents=True, exist_ok=True)
+                full = cv2.imread(str(job_path.parent / image), cv2.IMREAD_UNCHANGED)
+                h, w = full.shape[:2]
+                cv2.imwrite(str(target), cv2.resize(full, (w // 2, h // 2),
+                                                    interpolation=cv2.INTER_AREA))
+            halves.append(half.as_posix())
+        view["images"] = halves
+    out = job_path.with_name(f"{look}{HALF}__{rest}")
+    out.write_text(json.dumps(job, indent=1))
+    return out
+
+
 def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
     """Each view's job camera in ``look``: the clip's orthographic one, or a pinhole
     ``look.distance`` metres back along its line of sight showing the stage's centre as

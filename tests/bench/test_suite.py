@@ -191,6 +191,41 @@ def test_a_run_from_a_later_frame_is_posed_there_and_takes_every_step_th_frame_f
     np.testing.assert_allclose(job["views"][0]["camera"]["t"], np.array(full["t"])[3::2])
 
 
+@pytest.mark.parametrize("look", ["muybridge", "panning"])
+def test_a_halved_job_shows_every_point_at_half_its_pixel_on_footage_half_the_size(
+        tmp_path, look):
+    """``halve_job``: the images averaged 2 x 2 into the look's half folder, and each
+    camera (orthographic, or a pinhole that turns) putting any world point at (p + 0.5) / 2
+    - 0.5 where the original put it at p, so that a pixel's content stays under it."""
+    import cv2
+    from suite import CLIPS, write_job
+    from suite_footage import halve_job, stage
+
+    from core.job import load_job
+
+    clip_dir = tmp_path / "clip"
+    stage(CLIPS[0], clip_dir)
+    full = write_job(clip_dir, look, "3 views 15 fps", {}, start=1)
+    rng = np.random.default_rng(0)
+    for view in json.loads(full.read_text())["views"]:
+        for image in view["images"]:
+            (clip_dir / image).parent.mkdir(parents=True, exist_ok=True)
+            cv2.imwrite(str(clip_dir / image), rng.integers(0, 256, (360, 480, 3), np.uint8))
+    half = halve_job(full)
+    assert half.name == f"{look}_half__3_views_15_fps__from_1.json"
+    a, b = load_job(full), load_job(half)
+    X = rng.normal([0, 1, 0], 0.5, (20, 3))
+    for c in range(3):
+        big = cv2.imread(str(clip_dir / json.loads(full.read_text())["views"][c]["images"][1]))
+        img = cv2.imread(str(clip_dir / json.loads(half.read_text())["views"][c]["images"][1]))
+        assert img.shape == (180, 240, 3)
+        np.testing.assert_allclose(img[3, 5], big[6:8, 10:12].reshape(4, 3).mean(0), atol=1)
+        cams = [(a.moving[c] or a.cameras)[1 if a.moving[c] else c],
+                (b.moving[c] or b.cameras)[1 if b.moving[c] else c]]
+        p, q = cams[0].project(X), cams[1].project(X)
+        np.testing.assert_allclose(q, (p + 0.5) / 2 - 0.5, atol=1e-9)
+
+
 def test_a_run_with_settings_is_named_apart_from_the_defaults_and_from_other_settings(
         tmp_path):
     """``write_job``'s name: the defaults' plain, each setting's its own (whatever the keys'
