@@ -285,7 +285,8 @@ class FrameFit:
         bodies = [self._body_mask(key, kin_key, c, self.seq.grey(c, key_frame).shape)
                   for c in range(self.seq.n_views)]
         self.notes += self._cue.start(key_frame, bodies, [
-            sil.BODY_MARGIN * self.scales.magnification(c) for c in range(self.seq.n_views)],
+            max(1, round(sil.BODY_MARGIN * self.scales.magnification(c)))
+            for c in range(self.seq.n_views)],
             key.root_position)
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
@@ -459,7 +460,7 @@ class FrameFit:
         """Full-resolution pixels the blobs cover at ``pose`` in ``view``: for a large body
         (``auto_scale``) each square of 2^octaves pixels takes its top-left pixel's value,
         an error the backdrop's margin (as many times wider) covers."""
-        g = self.scales.magnification(view)
+        g = max(1, int(self.scales.magnification(view)))
         covered = self._label_maps(pose, kin, [shape], [0], [g], [view])[0][0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 

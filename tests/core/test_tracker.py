@@ -144,8 +144,8 @@ def test_each_views_octaves_count_doublings_of_the_bodys_height_there(body):
     sk, pose = body
     px = sk.height() * pose.views[0].pose.s
     assert all(v.pose.s == pose.views[0].pose.s for v in pose.views)
-    for times, octaves in [(0.4, 0), (1.3, 0), (1.5, 1), (2.0, 1), (2.7, 1), (3.0, 2),
-                           (4.0, 2), (8.0, 3)]:
+    for times, octaves in [(0.2, -2), (0.4, -1), (0.5, -1), (0.75, 0), (1.3, 0), (1.5, 1),
+                           (2.0, 1), (2.7, 1), (3.0, 2), (4.0, 2), (8.0, 3)]:
         enlarged = _enlarged(pose, times * REFERENCE_BODY_PIXELS / px)
         assert view_octaves(sk, enlarged) == [octaves] * 3
     mixed = _enlarged(pose, REFERENCE_BODY_PIXELS / px)
@@ -185,6 +185,52 @@ def test_a_body_twice_as_large_is_sampled_and_tracked_as_at_its_own_size(body):
     assert _limb_errors(sk, big, moved_big).max() > 2.0  # the motion is real
     assert after.max() < 0.5, after
     assert np.linalg.norm(res.frames[1].pose.root_position - moved.root_position) < 2e-3
+
+
+def test_a_body_half_as_large_in_two_views_is_sampled_and_tracked_as_at_its_own_size(body):
+    """A body half the reference's height loses the settings' coarsest pyramid level and is
+    sampled at every pixel, so that its level l holds the points the reference body's level
+    l + 1 does; its limbs are searched where the body is as large as the reference's are,
+    the silhouette reaches half as far, and the known small motion is followed (a body a
+    hundred pixels tall shows less of it: within a third). Seen by one view, the same body
+    keeps the settings as they are."""
+    sk, pose = body
+    px = sk.height() * pose.views[0].pose.s
+    ref = _enlarged(BodyPose(pose.rotations, pose.root_position, pose.views[:2]),
+                    REFERENCE_BODY_PIXELS / px)
+    moved = apply_update(sk, ref, _small_motion(sk, CALIBRATED, 2, seed=4), CALIBRATED)
+    half, moved_half = _enlarged(ref, 0.5), _enlarged(moved, 0.5)
+    assert view_octaves(sk, ref) == [0, 0] and view_octaves(sk, half) == [-1, -1]
+    f = REFERENCE_BODY_PIXELS / px
+    shapes = [(round(360 * f * g), round(320 * f * g)) for g in (1.0, 0.5)]
+    small_frames = [[render(sk, half, c, shape=shapes[1]),
+                     render(sk, moved_half, c, shape=shapes[1], noise=0.01, seed=c)]
+                    for c in range(2)]
+
+    def points(tracker, p, lv):
+        tracker.scale_to(p)
+        return len(tracker.point_set(p, Kinematics(sk, p), 0, 0, lv, 1.0).value)
+
+    small = Tracker(sk, small_frames, CALIBRATED)
+    reference = Tracker(sk, [[render(sk, ref, c, shape=shapes[0])] for c in range(2)],
+                        CALIBRATED)
+    for lv in range(2):
+        assert points(small, half, lv) == pytest.approx(points(reference, ref, lv + 1),
+                                                        rel=0.1)
+    assert small.seq.levels == [2, 2] and reference.seq.levels == [3, 3]
+    assert small.scales.view_levels(small.scales.search_level()) == [0, 0]
+    assert reference.scales.view_levels(reference.scales.search_level()) == [1, 1]
+    assert small.scales.cap(0) == pytest.approx(reference.scales.cap(0) / 2)
+    alone = Tracker(sk, small_frames[:1], CALIBRATED)
+    alone.scale_to(BodyPose(half.rotations, half.root_position, half.views[:1]))
+    assert alone.seq.levels == [3] and alone.scales.octaves == (0,)
+
+    res = track(Tracker(sk, small_frames, CALIBRATED, TrackerSettings(iterations=10)), half,
+                [0, 1])
+    before = _limb_errors(sk, half, moved_half)
+    after = _limb_errors(sk, res.frames[1].pose, moved_half)
+    assert before.max() > 2.0  # the motion is real
+    assert after.mean() < 0.3 * before.mean(), (after, before)
 
 
 def test_views_of_different_sizes_each_read_the_level_where_the_body_is_as_large(body):
