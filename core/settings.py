@@ -29,7 +29,9 @@ class TrackerSettings:
                              "each view: where it stands over about 280 pixels tall, that "
                              "view is tracked as if halved once per doubling over "
                              f"{REFERENCE_BODY_PIXELS:g}, with its finer pixels sampled "
-                             "sparsely on added pyramid levels (faster, and steadier)")
+                             "sparsely on added pyramid levels (faster, and steadier); with "
+                             "several views, where it stands under about 140, with a coarse "
+                             "level fewer, every pixel sampled and a shorter silhouette reach")
     key_weight: float = _knob(0.5, "Weight of the key frame's pixels against the previous "
                               "frame's: holds the track against drift")
     colour: bool = _knob(True, "Match colour footage in its hue as well as its brightness: "
