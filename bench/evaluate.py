@@ -12,11 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.spatial.transform import Rotation
 
 from core import se3
 from core.bvh import BvhFile
-from core.skeleton import HINGE, Skeleton
+from core.skeleton import HINGE, Skeleton, twist_about
 
 UP = np.array([0.0, 1.0, 0.0])  # the captures' vertical (``suite_footage``'s stage)
 
@@ -97,10 +96,8 @@ def swing_twist(R: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
     """A rotation R (3, 3) split as R = swing @ twist, the twist about the unit ``axis`` and
     the swing about an axis across it: (swing, twist) in degrees, the twist signed about
     ``axis`` in (-180, 180], the swing in [0, 180] (the angle R turns ``axis`` by)."""
-    x, y, z, w = Rotation.from_matrix(R).as_quat()
-    along = float(np.dot((x, y, z), axis))
-    twist = np.degrees(2 * np.arctan2(along, w))
-    twist = twist - 360 if twist > 180 else twist + 360 if twist <= -180 else twist
+    twist = np.degrees(twist_about(R, axis))  # in [-180, 180]
+    twist = twist + 360 if twist <= -180 else twist
     swing = np.degrees(float(se3.angle_between_vectors(axis, R @ axis)))
     return swing, float(twist)
 
