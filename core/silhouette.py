@@ -30,6 +30,7 @@ import cv2
 import numpy as np
 
 from .camera import Camera, Pinhole, turn_homography, turns_in_place
+from .exposure import exposure_gain
 from .image import to_float, to_uint8, true_pixels
 
 MIN_CONTRAST = 0.06  # smallest brightness difference from the backdrop called foreground
@@ -101,7 +102,8 @@ class Backdrop:
         found = [np.zeros(0)]
         for grey, c in frames:
             if c is not None and c.shape == self.colour.shape:
-                same = (np.abs(grey[::k, ::k] - self.image[::k, ::k]) <= self.threshold) \
+                g = self.exposure(grey)
+                same = (np.abs(grey[::k, ::k] - g * self.image[::k, ::k]) <= self.threshold) \
                     & ~self.unseen[::k, ::k]
                 found.append(_chroma(c[::k, ::k][same], self.colour[::k, ::k][same])[0])
         found = np.concatenate(found)
@@ -118,12 +120,19 @@ class Backdrop:
         body (its blobs' pixels) is not."""
         if grey.shape != self.image.shape:
             return
+        g = self.exposure(grey)  # taken at the backdrop's own exposure
         seen = self.unseen & ~self.widen(body)
-        self.image[seen] = grey[seen]
+        self.image[seen] = grey[seen] / g
         if self.colour is not None and colour is not None:
-            self.colour[seen] = colour[seen]
+            self.colour[seen] = np.clip(colour[seen] / g, 0, 255).astype(np.uint8)
             self._colour_half = None
         self.unseen &= ~seen
+
+    def exposure(self, grey: np.ndarray) -> float:
+        """A frame's (grey (H, W)) exposure against this backdrop's
+        (``exposure.exposure_gain`` over the pixels it has seen), where they overlap."""
+        h, w = (min(a, b) for a, b in zip(grey.shape, self.image.shape))
+        return exposure_gain(grey[:h, :w], self.image[:h, :w], ~self.unseen[:h, :w])
 
     @property
     def learning(self) -> bool:
@@ -133,7 +142,8 @@ class Backdrop:
     def foreground(self, grey: np.ndarray, colour: np.ndarray | None = None,
                    against: tuple | None = None) -> np.ndarray:
         """Foreground map (H, W) of a full-resolution frame (grey, and colour or None):
-        pixels off the backdrop in brightness or in colour (``recoloured``; not a turning
+        pixels off the backdrop (brought to the frame's exposure, ``exposure``; a turning
+        camera's as it is) in brightness or in colour (``recoloured``; not a turning
         camera's, resampled, whose edges would all be off by a pixel's colour, nor where
         the footage's colour noise reads 0: a grey scene stored in colour, whose colour is
         only rounding, has no noise to set the colour's bar by), specks removed, are
@@ -148,6 +158,11 @@ class Backdrop:
         h, w = (min(a, b) for a, b in zip(grey.shape, image.shape))
         fg = np.zeros(grey.shape, np.uint8)
         seen, image = grey[:h, :w], image[:h, :w]
+        # the backdrop brought to the frame's exposure; a turning camera's is drawn from the
+        # latest frames, of exposures near its own, warped (their resampling reads as a
+        # gain of a few per cent)
+        gain = self.exposure(grey) if against is None else 1.0
+        image = gain * image
         if self.reach:  # off the range of the backdrop's values that near
             near = np.ones((2 * self.reach + 1,) * 2, np.uint8)
             off = np.maximum(cv2.erode(image, near) - seen, seen - cv2.dilate(image, near))
@@ -167,7 +182,8 @@ class Backdrop:
             off_backdrop = np.flatnonzero(fg > 0)
             unsure = np.zeros(fg.shape, np.uint8)
             unsure.ravel()[off_backdrop] = self.shaded(
-                *(c.reshape(-1, 3).take(off_backdrop, 0) for c in (colour, backdrop_colour)))
+                colour.reshape(-1, 3).take(off_backdrop, 0),
+                gain * backdrop_colour.reshape(-1, 3).take(off_backdrop, 0))
             # specks too: a shadow is a patch, a lone pixel the backdrop's colour is noise
             unsure = cv2.morphologyEx(unsure, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
             fg[unsure > 0] = UNSURE
@@ -448,10 +464,11 @@ class SilhouetteCue:
         self.backdrops: list[Backdrop | TurningBackdrop | None] | None = None
         self._foregrounds: dict[tuple[int, int], LevelMaps] = {}  # (view, frame)
         self._recent: list[int] = []  # the frames whose foregrounds are kept, latest last
+        self._exposures: dict[tuple[int, int], float] = {}  # (view, frame)
 
     def reset(self) -> None:
         """Forget the backdrops (a new key pose, or a new size of the body's pyramids)."""
-        self.backdrops, self._foregrounds, self._recent = None, {}, []
+        self.backdrops, self._foregrounds, self._recent, self._exposures = None, {}, [], {}
 
     @property
     def started(self) -> bool:
@@ -545,6 +562,17 @@ class SilhouetteCue:
             self._foregrounds[view, frame] = LevelMaps(bd.foreground(frame, *seen) if isinstance(
                 bd, TurningBackdrop) else bd.foreground(*seen))
         return self._foregrounds[view, frame]
+
+    def exposure(self, view: int, frame: int) -> float | None:
+        """``frame``'s exposure in ``view`` against the view's still backdrop
+        (``Backdrop.exposure``), kept; None where the view has none (a camera that moves or
+        turns: its backdrop is drawn from frames of their own exposures)."""
+        bd = self.backdrops[view] if self.backdrops is not None else None
+        if not isinstance(bd, Backdrop):
+            return None
+        if (view, frame) not in self._exposures:
+            self._exposures[view, frame] = bd.exposure(self.seq.grey(view, frame))
+        return self._exposures[view, frame]
 
     def unseen(self, view: int) -> bool:
         """Whether ``view``'s backdrop can still learn from a tracked frame."""

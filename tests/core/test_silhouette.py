@@ -103,6 +103,30 @@ def test_the_backdrop_is_learned_behind_the_body_as_it_moves_off():
                                   cv2.pyrDown(fg.astype(np.float32)).shape)
 
 
+def test_a_frame_of_another_exposure_is_foreground_only_where_the_body_is():
+    """A camera's automatic exposure brightens a frame by 30 %: against the backdrop brought
+    to that exposure only the body differs, and what the frame shows of the backdrop is
+    learned back at the backdrop's own exposure."""
+    rng = np.random.default_rng(4)
+    shape = (120, 160)
+    backdrop = cv2.GaussianBlur(rng.uniform(0.2, 0.7, shape).astype(np.float32), (0, 0), 2)
+
+    def frame(centre, gain):
+        img = backdrop.copy()
+        img[_disc(shape, centre, 18)] = 0.95
+        return np.clip(gain * img + rng.normal(0, 0.004, shape), 0, 1).astype(np.float32)
+
+    home = (80, 60)
+    bd = Backdrop(frame(home, 1.0), _disc(shape, home, 18), [(frame(home, 1.0), None)] * 5)
+    fg = bd.foreground(frame((110, 60), 1.3)) == FOREGROUND
+    truth = _disc(shape, (110, 60), 18)
+    assert (fg & truth).sum() / (fg | truth).sum() > 0.97
+    assert np.mean(np.abs(1.3 * backdrop - backdrop) > bd.threshold) > 0.5  # else all of it
+    bd.learn(frame((30, 60), 1.3), _disc(shape, (30, 60), 18))
+    under = _disc(shape, home, 18)
+    assert np.abs(bd.image - backdrop)[under].max() < 0.03
+
+
 def _sunlit(wall_colour, shape=(120, 160), seed=2, body_grey=0.2):
     """A textured wall of one colour (BGR, 0-1) with a grey body on it, frame by frame: the
     body (a disc) and its cast shadow (the wall at 0.45 of its light, a disc beside it)
