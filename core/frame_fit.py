@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Collection, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -288,6 +288,27 @@ class FrameFit:
             max(1, round(sil.BODY_MARGIN * self.scales.magnification(c)))
             for c in range(self.seq.n_views)],
             key.root_position)
+
+    def _exposed(self, sets: list[PointSet], frame: int, prev_frame: int, key: BodyPose,
+                 key_frame: int) -> list[PointSet]:
+        """``sets`` (per view: the previous frame's points, then the key frame's) with each
+        frame's values brought to ``frame``'s exposure (``SilhouetteCue.exposure``: a
+        camera's automatic exposure multiplies every pixel, and the filtered levels with
+        it); as they are in a view without a still backdrop to read exposures against."""
+        if self.settings.silhouette <= 0:
+            return sets
+        self._start_cue(key, key_frame)
+        out = []
+        for ps in sets:
+            now = self._cue.exposure(ps.view, frame)
+            if now is None:
+                out.append(ps)
+                continue
+            lengths = ps.lengths or (len(ps.value),)
+            gains = [now / self._cue.exposure(ps.view, f)
+                     for f in (prev_frame, key_frame)[:len(lengths)]]
+            out.append(replace(ps, value=ps.value * np.repeat(gains, lengths)[:, None]))
+        return out
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
                       ) -> tuple[BodyPose, list[str], tuple]:
@@ -822,6 +843,7 @@ class FrameFit:
                                                           s.key_weight)
                     view_sets.append(self.key_sets[k])
                 sets.append(PointSet.joined(view_sets))
+            sets = self._exposed(sets, frame, prev_frame, key, key_frame)
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and level == self.scales.search_level():
                 searched, turned, searched_on = self._search_limbs(est, frame, key, key_frame)

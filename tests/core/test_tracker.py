@@ -100,6 +100,39 @@ def test_recovers_a_known_small_motion_in_three_views(body, mode):
             assert err < 0.3  # pixels
 
 
+def test_frames_of_another_exposure_are_tracked_against_templates_brought_to_it(
+        body, monkeypatch):
+    """A camera's automatic exposure multiplies frames 1 and 2 by 1.3 and 0.75: each frame's
+    exposure is read against the still backdrop, the previous frame's and the key frame's
+    pixels are brought to it, and the motion is recovered and its pixels matched as at one
+    exposure; templates compared as they were leave the brightness unexplained."""
+    sk, pose = body
+    poses = [pose]
+    for seed in (4, 5):
+        poses.append(apply_update(sk, poses[-1], _small_motion(sk, CALIBRATED, 3, seed=seed),
+                                  CALIBRATED))
+
+    def tracked(gains):
+        frames = [[np.clip(g * render(sk, p, c, noise=0.01, seed=c), 0, 1)
+                   for g, p in zip(gains, poses)] for c in range(3)]
+        tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10))
+        res = track(tracker, pose, [0, 1, 2])
+        return (tracker, [_limb_errors(sk, f.pose, p).max() for f, p in
+                          zip(res.frames[1:], poses[1:])], [f.residual for f in res.frames[1:]])
+
+    _, _, steady = tracked((1.0, 1.0, 1.0))
+    gains = (1.0, 1.3, 0.75)
+    tracker, errors, residuals = tracked(gains)
+    read = [[tracker._cue.exposure(c, f) for f in range(3)] for c in range(3)]
+    np.testing.assert_allclose(read, [gains] * 3, rtol=0.01)
+    assert max(errors) < 0.5, errors
+    # in image units, the noise the gain scales with the image
+    np.testing.assert_allclose(np.divide(residuals, gains[1:]), steady, rtol=0.2)
+    monkeypatch.setattr(sil.SilhouetteCue, "exposure", lambda self, view, frame: None)
+    _, _, unexplained = tracked(gains)
+    assert min(np.divide(unexplained, gains[1:]) / steady) > 1.3, (unexplained, steady)
+
+
 def test_cloth_that_differs_in_hue_alone_is_followed_in_colour(body):
     """Footage whose every pixel has one brightness: its grey image is flat to rounding, and
     only the chroma channels show the cloth move (the brightness rows alone; no
