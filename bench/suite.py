@@ -2,7 +2,8 @@
 and scored against the capture beside two references on the same frames.
 
     python bench/suite.py [--quick] [--bandai-namco FOLDER] [--settings JSON] [--starts N]
-                          [--clips NAME,...] [--looks NAME,...] [--half-size] [--workers N]
+                          [--clips NAME,...] [--looks NAME,...] [--half-size] [--exposure-drift]
+                          [--workers N]
                           [--write PATH]
 
 Each clip (a capture of ``captures.NAMINGS``) is rendered once per look
@@ -25,6 +26,8 @@ that holds them (``bn_*.bvh``) to include them. Two renderers, then two trackers
 once, one per core of a two-core machine; the tracking speed of a run alone, as a user's, is
 ``--workers 1`` (nothing else running). ``--half-size`` tracks every run on its footage
 halved (``suite_footage.halve_job``): the body about 100 pixels tall instead of 205.
+``--exposure-drift`` tracks every run on its footage with the exposure drifting
+(``suite_footage.drift_job``: plus or minus 30 % over one and a half seconds).
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ from suite_footage import (  # noqa: E402
     VIDEO_FPS,
     VIEWS,
     Clip,
+    drift_job,
     frame_ext,
     halve_job,
     look_cameras,
@@ -99,6 +103,7 @@ DEFAULT_RUNS = ("3 views 15 fps", "1 lateral view 15 fps", "3 views 30 fps",
                 "1 lateral view 30 fps")
 QUICK_RUNS = ("3 views 15 fps", "1 lateral view 15 fps")
 HALF_LABEL = ", half size"  # after a look's name in the tables, with ``--half-size``
+DRIFT_LABEL = ", exposure drifting"  # and with ``--exposure-drift``
 
 
 def slug(text: str) -> str:
@@ -391,6 +396,8 @@ def main(argv=None) -> int:
                     "tracked from, its scores averaged (default 3, or 1 with --quick)")
     ap.add_argument("--half-size", action="store_true",
                     help="track on the footage halved in size (the body about 100 pixels tall)")
+    ap.add_argument("--exposure-drift", action="store_true",
+                    help="track on the footage with its exposure drifting (plus or minus 30 %%)")
     ap.add_argument("--workers", type=int, default=2,
                     help="renderers, then trackers, run at once (default 2, one per core; 1 "
                     "for a tracker's speed alone)")
@@ -424,7 +431,10 @@ def main(argv=None) -> int:
                     job = write_job(clip_dir, look, run, settings, k)
                     if a.half_size:
                         job = halve_job(job)
-                    jobs.append(((clip.name, look + HALF_LABEL * a.half_size, run), k, job))
+                    if a.exposure_drift:
+                        job = drift_job(job)
+                    label = look + HALF_LABEL * a.half_size + DRIFT_LABEL * a.exposure_drift
+                    jobs.append(((clip.name, label, run), k, job))
     scored: dict[tuple, list[dict]] = {}
     with ThreadPoolExecutor(a.workers) as pool:  # each tracker uses one BLAS thread
         for (key, k, _), row in zip(jobs, pool.map(
@@ -444,6 +454,7 @@ def main(argv=None) -> int:
             f"Written by `{command_line(argv)}` on {time.strftime('%Y-%m-%d')}. Each clip is two "
             "seconds of real motion capture rendered in each look"
             f"{', halved in size (the body about 100 pixels tall),' if a.half_size else ''}"
+            f"{', its exposure drifting (plus or minus 30 %),' if a.exposure_drift else ''}"
             " and tracked with "
             f"{settings_phrase(settings)} and the default blobs, from each of its first {starts} "
             "frame(s) (posed there by the capture): tracking is chaotic, so *tracker* is the "

@@ -222,6 +222,43 @@ def halve_job(job_path: Path) -> Path:
     return out
 
 
+DRIFT = "_drift"  # after a look's name: its footage with the exposure drifting (``drift_job``)
+DRIFT_SWING = 0.3  # the drifting exposure's gain swings this far either side of 1
+DRIFT_PERIOD = 45  # capture frames (30 fps) of one swing up and down: one and a half seconds
+
+
+def drift_gain(frame: int) -> float:
+    """The drifting exposure's gain on capture frame ``frame``: 1 + 0.3 sin(2 pi f / 45)."""
+    return 1.0 + DRIFT_SWING * float(np.sin(2 * np.pi * frame / DRIFT_PERIOD))
+
+
+def drift_job(job_path: Path) -> Path:
+    """The suite job ``job_path`` (``<look>__<run>...json``) on its footage with the exposure
+    drifting, as a phone's automatic exposure does: every image (its name its capture
+    frame) times ``drift_gain``, clipped, into its folder's ``_drift`` twin beside it
+    (once); the job written as ``<look>_drift__<run>...json``."""
+    import cv2
+
+    look, rest = job_path.name.split("__", 1)
+    job = json.loads(job_path.read_text())
+    for view in job["views"]:
+        drifted = []
+        for image in view["images"]:
+            parts = Path(image).parts
+            out = Path(parts[0] + DRIFT, *parts[1:])
+            target = job_path.parent / out
+            if not target.exists():
+                target.parent.mkdir(parents=True, exist_ok=True)
+                img = cv2.imread(str(job_path.parent / image), cv2.IMREAD_UNCHANGED)
+                gain = drift_gain(int(Path(image).stem))
+                cv2.imwrite(str(target), np.clip(img * gain + 0.5, 0, 255).astype(np.uint8))
+            drifted.append(out.as_posix())
+        view["images"] = drifted
+    out = job_path.with_name(f"{look}{DRIFT}__{rest}")
+    out.write_text(json.dumps(job, indent=1))
+    return out
+
+
 def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
     """Each view's job camera in ``look``: the clip's orthographic one, or a pinhole
     ``look.distance`` metres back along its line of sight showing the stage's centre as

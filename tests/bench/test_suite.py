@@ -226,6 +226,38 @@ def test_a_halved_job_shows_every_point_at_half_its_pixel_on_footage_half_the_si
         np.testing.assert_allclose(q, (p + 0.5) / 2 - 0.5, atol=1e-9)
 
 
+def test_a_drifting_job_shows_each_frame_times_its_capture_frames_gain(tmp_path):
+    """``drift_job``: each image (named by its capture frame) times ``drift_gain`` of that
+    frame, clipped, in the look's drift folder; the cameras and everything else as they
+    were."""
+    import cv2
+    from suite import CLIPS, write_job
+    from suite_footage import drift_gain, drift_job, stage
+
+    clip_dir = tmp_path / "clip"
+    stage(CLIPS[0], clip_dir)
+    full = write_job(clip_dir, "muybridge", "1 lateral view 15 fps", {})
+    img = np.full((36, 48, 3), 100, np.uint8)
+    img[:, :8] = 250  # clipped where the gain is over 1.02
+    for view in json.loads(full.read_text())["views"]:
+        for image in view["images"]:
+            (clip_dir / image).parent.mkdir(parents=True, exist_ok=True)
+            cv2.imwrite(str(clip_dir / image), img)
+    drifted = drift_job(full)
+    assert drifted.name == "muybridge_drift__1_lateral_view_15_fps.json"
+    a, b = json.loads(full.read_text()), json.loads(drifted.read_text())
+    assert b["views"][0]["camera"] == a["views"][0]["camera"]
+    gains = []
+    for image in b["views"][0]["images"]:
+        assert image.startswith("muybridge_drift/")
+        out = cv2.imread(str(clip_dir / image))
+        gain = drift_gain(int(Path(image).stem))
+        assert out[0, 20, 0] == round(100 * gain)
+        assert out[0, 0, 0] == min(255, round(250 * gain))
+        gains.append(gain)
+    assert min(gains) < 0.75 and max(gains) > 1.25  # the run sees the whole swing
+
+
 def test_a_run_with_settings_is_named_apart_from_the_defaults_and_from_other_settings(
         tmp_path):
     """``write_job``'s name: the defaults' plain, each setting's its own (whatever the keys'
