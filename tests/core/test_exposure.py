@@ -46,7 +46,7 @@ def test_a_scene_too_dark_to_read_keeps_its_exposure():
     backdrop = np.full((120, 160), 0.02, np.float32)
     frame = backdrop * 1.4
     frame[:10, :10 * STRIDE] = 0.5  # too few readable pixels on their own
-    assert np.count_nonzero((frame[::STRIDE, ::STRIDE] > 0.05)) < MIN_PIXELS
+    assert np.count_nonzero(frame[::STRIDE, ::STRIDE] > 0.05) < MIN_PIXELS
     assert exposure_gain(frame, backdrop) == 1.0
 
 
