@@ -65,6 +65,7 @@ from .solver import (
 )
 
 SIL_MAX_ROWS = 300  # silhouette mismatches per view that enter the normal equations
+EXPOSURE_NOTE = "exposure: "  # how the run's note on the exposures it followed begins
 # level pixels from any pixel that may be the body past which a lost limb's pixel of the
 # frame before is taken for backdrop (``release_lost_limbs``)
 LOST_REACH = 1.5
@@ -309,6 +310,21 @@ class FrameFit:
                      for f in (prev_frame, key_frame)[:len(lengths)]]
             out.append(replace(ps, value=ps.value * np.repeat(gains, lengths)[:, None]))
         return out
+
+    def exposure_note(self) -> str | None:
+        """What to tell the user of the exposures the run followed (``_exposed``): each view
+        whose footage was read at another exposure than the key frame's, and how far; None
+        where every frame's was the key frame's."""
+        if not self._cue.started:
+            return None
+        spans = [self._cue.exposure_span(c) for c in range(self.seq.n_views)]
+        moved = [f"view {c + 1} {lo:.2f}-{hi:.2f}x" for c, (lo, hi) in
+                 ((c, span) for c, span in enumerate(spans) if span) if (lo, hi) != (1.0, 1.0)]
+        if not moved:
+            return None
+        return (f"{EXPOSURE_NOTE}the footage's exposure changed ({', '.join(moved)} the key "
+                "frame's), as a camera's automatic exposure does: each frame was compared "
+                "with the backdrop and the frames before at its own")
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
                       ) -> tuple[BodyPose, list[str], tuple]:

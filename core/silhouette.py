@@ -465,10 +465,12 @@ class SilhouetteCue:
         self._foregrounds: dict[tuple[int, int], LevelMaps] = {}  # (view, frame)
         self._recent: list[int] = []  # the frames whose foregrounds are kept, latest last
         self._exposures: dict[tuple[int, int], float] = {}  # (view, frame)
+        self._spans: dict[int, tuple[float, float]] = {}  # per view, its lowest and highest
 
     def reset(self) -> None:
         """Forget the backdrops (a new key pose, or a new size of the body's pyramids)."""
-        self.backdrops, self._foregrounds, self._recent, self._exposures = None, {}, [], {}
+        self.backdrops, self._foregrounds, self._recent = None, {}, []
+        self._exposures, self._spans = {}, {}
 
     @property
     def started(self) -> bool:
@@ -571,8 +573,15 @@ class SilhouetteCue:
         if not isinstance(bd, Backdrop):
             return None
         if (view, frame) not in self._exposures:
-            self._exposures[view, frame] = bd.exposure(self.seq.grey(view, frame))
+            gain = self._exposures[view, frame] = bd.exposure(self.seq.grey(view, frame))
+            lo, hi = self._spans.get(view, (gain, gain))
+            self._spans[view] = (min(lo, gain), max(hi, gain))
         return self._exposures[view, frame]
+
+    def exposure_span(self, view: int) -> tuple[float, float] | None:
+        """The lowest and highest exposure read in ``view`` so far (``exposure``), None
+        before any."""
+        return self._spans.get(view)
 
     def unseen(self, view: int) -> bool:
         """Whether ``view``'s backdrop can still learn from a tracked frame."""

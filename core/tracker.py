@@ -28,7 +28,7 @@ from .blas import one_blas_thread
 from .camera import Camera
 from .confidence import UNSEEN, UNSURE_FLAG
 from .errors import InputError
-from .frame_fit import FrameFit, FrameResult
+from .frame_fit import EXPOSURE_NOTE, FrameFit, FrameResult
 from .linearize import Kinematics
 from .pose import CALIBRATED, INDEPENDENT, BodyPose, extrapolate
 from .settings import TrackerSettings
@@ -260,6 +260,9 @@ class Tracker(FrameFit):
                 continue
             with one_blas_thread():
                 res = self._next_frame(history, key, key_frame, frame, residuals)
+            self.notes = [n for n in self.notes if not n.startswith(EXPOSURE_NOTE)]
+            if note := self.exposure_note():
+                self.notes.append(note)
             if np.isfinite(res.residual):
                 residuals.append(res.residual)
             self.seq.keep_only({(c, f) for c in range(self.seq.n_views)

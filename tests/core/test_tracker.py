@@ -117,12 +117,19 @@ def test_frames_of_another_exposure_are_tracked_against_templates_brought_to_it(
                    for g, p in zip(gains, poses)] for c in range(3)]
         tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10))
         res = track(tracker, pose, [0, 1, 2])
+        notes.append(res.notes)
         return (tracker, [_limb_errors(sk, f.pose, p).max() for f, p in
                           zip(res.frames[1:], poses[1:])], [f.residual for f in res.frames[1:]])
 
+    notes = []
     _, _, steady = tracked((1.0, 1.0, 1.0))
     gains = (1.0, 1.3, 0.75)
     tracker, errors, residuals = tracked(gains)
+    assert notes[0] == []  # one exposure: nothing to say
+    assert notes[1] == [
+        "exposure: the footage's exposure changed (view 1 0.75-1.30x, view 2 0.75-1.30x, view "
+        "3 0.75-1.30x the key frame's), as a camera's automatic exposure does: each frame was "
+        "compared with the backdrop and the frames before at its own"]
     read = [[tracker._cue.exposure(c, f) for f in range(3)] for c in range(3)]
     np.testing.assert_allclose(read, [gains] * 3, rtol=0.01)
     assert max(errors) < 0.5, errors
