@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Collection, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -290,31 +290,10 @@ class FrameFit:
             for c in range(self.seq.n_views)],
             key.root_position)
 
-    def _exposed(self, sets: list[PointSet], frame: int, prev_frame: int, key: BodyPose,
-                 key_frame: int) -> list[PointSet]:
-        """``sets`` (per view: the previous frame's points, then the key frame's) with each
-        frame's values brought to ``frame``'s exposure (``SilhouetteCue.exposure``: a
-        camera's automatic exposure multiplies every pixel, and the filtered levels with
-        it); as they are in a view without a still backdrop to read exposures against."""
-        if self.settings.silhouette <= 0:
-            return sets
-        self._start_cue(key, key_frame)
-        out = []
-        for ps in sets:
-            now = self._cue.exposure(ps.view, frame)
-            if now is None:
-                out.append(ps)
-                continue
-            lengths = ps.lengths or (len(ps.value),)
-            gains = [now / self._cue.exposure(ps.view, f)
-                     for f in (prev_frame, key_frame)[:len(lengths)]]
-            out.append(replace(ps, value=ps.value * np.repeat(gains, lengths)[:, None]))
-        return out
-
     def exposure_note(self) -> str | None:
-        """What to tell the user of the exposures the run followed (``_exposed``): each view
-        whose footage was read at another exposure than the key frame's, and how far; None
-        where every frame's was the key frame's."""
+        """What to tell the user of the exposures the run followed (``SilhouetteCue.exposure``):
+        each view whose footage was read at another exposure than its backdrop's, and how
+        far; None where every frame's was the backdrop's."""
         if not self._cue.started:
             return None
         spans = [self._cue.exposure_span(c) for c in range(self.seq.n_views)]
@@ -323,8 +302,8 @@ class FrameFit:
         if not moved:
             return None
         return (f"{EXPOSURE_NOTE}the footage's exposure changed ({', '.join(moved)} the key "
-                "frame's), as a camera's automatic exposure does: each frame was compared "
-                "with the backdrop and the frames before at its own")
+                "frame's), as a camera's automatic exposure does: each frame's silhouette "
+                "was read against the backdrop brought to its exposure")
 
     def _search_limbs(self, est: BodyPose, frame: int, key: BodyPose, key_frame: int
                       ) -> tuple[BodyPose, list[str], tuple]:
@@ -859,7 +838,6 @@ class FrameFit:
                                                           s.key_weight)
                     view_sets.append(self.key_sets[k])
                 sets.append(PointSet.joined(view_sets))
-            sets = self._exposed(sets, frame, prev_frame, key, key_frame)
             kin = Kinematics(self.skeleton, est)
             if s.limb_search > 0 and level == self.scales.search_level():
                 searched, turned, searched_on = self._search_limbs(est, frame, key, key_frame)

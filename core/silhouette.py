@@ -140,7 +140,7 @@ class Backdrop:
         return bool(self.unseen.any())
 
     def foreground(self, grey: np.ndarray, colour: np.ndarray | None = None,
-                   against: tuple | None = None) -> np.ndarray:
+                   against: tuple | None = None, gain: float | None = None) -> np.ndarray:
         """Foreground map (H, W) of a full-resolution frame (grey, and colour or None):
         pixels off the backdrop (brought to the frame's exposure, ``exposure``; a turning
         camera's as it is) in brightness or in colour (``recoloured``; not a turning
@@ -153,7 +153,7 @@ class Backdrop:
         (top-left corners together); the rest is backdrop. ``against``: (grey, colour or
         None, unknown) of the frame's own size to compare with instead of this backdrop's
         image (a turning camera's, brought into the frame's view: ``TurningBackdrop``), its
-        unknown pixels ``UNSURE``."""
+        unknown pixels ``UNSURE``. ``gain``: the frame's ``exposure``, when already read."""
         image, backdrop_colour, unknown = against or (self.image, self.colour, None)
         h, w = (min(a, b) for a, b in zip(grey.shape, image.shape))
         fg = np.zeros(grey.shape, np.uint8)
@@ -161,7 +161,10 @@ class Backdrop:
         # the backdrop brought to the frame's exposure; a turning camera's is drawn from the
         # latest frames, of exposures near its own, warped (their resampling reads as a
         # gain of a few per cent)
-        gain = self.exposure(grey) if against is None else 1.0
+        if against is not None:
+            gain = 1.0
+        elif gain is None:
+            gain = self.exposure(grey)
         image = gain * image
         if self.reach:  # off the range of the backdrop's values that near
             near = np.ones((2 * self.reach + 1,) * 2, np.uint8)
@@ -562,7 +565,7 @@ class SilhouetteCue:
             bd = self.backdrops[view]
             seen = (self.seq.grey(view, frame), self.seq.colour(view, frame))
             self._foregrounds[view, frame] = LevelMaps(bd.foreground(frame, *seen) if isinstance(
-                bd, TurningBackdrop) else bd.foreground(*seen))
+                bd, TurningBackdrop) else bd.foreground(*seen, gain=self.exposure(view, frame)))
         return self._foregrounds[view, frame]
 
     def exposure(self, view: int, frame: int) -> float | None:
