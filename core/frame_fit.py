@@ -296,9 +296,8 @@ class FrameFit:
         far; None where every frame's was the backdrop's."""
         if not self._cue.started:
             return None
-        spans = [self._cue.exposure_span(c) for c in range(self.seq.n_views)]
-        moved = [f"view {c + 1} {lo:.2f}-{hi:.2f}x" for c, (lo, hi) in
-                 ((c, span) for c, span in enumerate(spans) if span) if (lo, hi) != (1.0, 1.0)]
+        moved = [f"view {c + 1} {span[0]:.2f}-{span[1]:.2f}x" for c in range(self.seq.n_views)
+                 if (span := self._cue.exposure_span(c)) not in (None, (1.0, 1.0))]
         if not moved:
             return None
         return (f"{EXPOSURE_NOTE}the footage's exposure changed ({', '.join(moved)} the key "
