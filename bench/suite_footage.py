@@ -193,33 +193,46 @@ def halved_camera(cam: dict) -> dict:
     return out
 
 
-def halve_job(job_path: Path) -> Path:
+def _retouched_job(job_path: Path, tag: str, retouch, camera=None) -> Path:
     """The suite job ``job_path`` (``<look>__<run>...json``, its images under ``<look>/``) on
-    its footage halved in size: every image's 2 x 2 pixels averaged into
-    ``<look>_half/`` beside it (once), the cameras with it (``halved_camera``); the job
-    written as ``<look>_half__<run>...json``. A body 100 pixels tall instead of 205, as a
-    wide shot or a far camera shows one."""
+    its footage retouched: each image ``retouch(image, name)`` (its pixels as stored, its
+    path in the job) into ``<look><tag>/`` beside it (once), each view's camera
+    ``camera(camera)`` (None: as it is); the job written as ``<look><tag>__<run>...json``."""
     import cv2
 
     look, rest = job_path.name.split("__", 1)
     job = json.loads(job_path.read_text())
     for view in job["views"]:
-        view["camera"] = halved_camera(view["camera"])
-        halves = []
+        if camera is not None:
+            view["camera"] = camera(view["camera"])
+        retouched = []
         for image in view["images"]:
-            half = Path(look + HALF, *Path(image).parts[1:])
-            target = job_path.parent / half
+            parts = Path(image).parts
+            out = Path(parts[0] + tag, *parts[1:])
+            target = job_path.parent / out
             if not target.exists():
                 target.parent.mkdir(parents=True, exist_ok=True)
-                full = cv2.imread(str(job_path.parent / image), cv2.IMREAD_UNCHANGED)
-                h, w = full.shape[:2]
-                cv2.imwrite(str(target), cv2.resize(full, (w // 2, h // 2),
-                                                    interpolation=cv2.INTER_AREA))
-            halves.append(half.as_posix())
-        view["images"] = halves
-    out = job_path.with_name(f"{look}{HALF}__{rest}")
+                stored = cv2.imread(str(job_path.parent / image), cv2.IMREAD_UNCHANGED)
+                cv2.imwrite(str(target), retouch(stored, image))
+            retouched.append(out.as_posix())
+        view["images"] = retouched
+    out = job_path.with_name(f"{look}{tag}__{rest}")
     out.write_text(json.dumps(job, indent=1))
     return out
+
+
+def halve_job(job_path: Path) -> Path:
+    """The suite job ``job_path`` on its footage halved in size (``_retouched_job``): every
+    image's 2 x 2 pixels averaged into ``<look>_half/``, the cameras with it
+    (``halved_camera``), the job ``<look>_half__<run>...json``. A body 100 pixels tall
+    instead of 205, as a wide shot or a far camera shows one."""
+    import cv2
+
+    def halved(img: np.ndarray, _name: str) -> np.ndarray:
+        h, w = img.shape[:2]
+        return cv2.resize(img, (w // 2, h // 2), interpolation=cv2.INTER_AREA)
+
+    return _retouched_job(job_path, HALF, halved, halved_camera)
 
 
 DRIFT = "_drift"  # after a look's name: its footage with the exposure drifting (``drift_job``)
@@ -233,30 +246,16 @@ def drift_gain(frame: int) -> float:
 
 
 def drift_job(job_path: Path) -> Path:
-    """The suite job ``job_path`` (``<look>__<run>...json``) on its footage with the exposure
-    drifting, as a phone's automatic exposure does: every image (its name its capture
-    frame) times ``drift_gain``, clipped, into its folder's ``_drift`` twin beside it
-    (once); the job written as ``<look>_drift__<run>...json``."""
-    import cv2
+    """The suite job ``job_path`` on its footage with the exposure drifting, as a phone's
+    automatic exposure does (``_retouched_job``): every image (its name its capture frame)
+    times ``drift_gain``, clipped, into ``<look>_drift/``; the job
+    ``<look>_drift__<run>...json``."""
 
-    look, rest = job_path.name.split("__", 1)
-    job = json.loads(job_path.read_text())
-    for view in job["views"]:
-        drifted = []
-        for image in view["images"]:
-            parts = Path(image).parts
-            out = Path(parts[0] + DRIFT, *parts[1:])
-            target = job_path.parent / out
-            if not target.exists():
-                target.parent.mkdir(parents=True, exist_ok=True)
-                img = cv2.imread(str(job_path.parent / image), cv2.IMREAD_UNCHANGED)
-                gain = drift_gain(int(Path(image).stem))
-                cv2.imwrite(str(target), np.clip(img * gain + 0.5, 0, 255).astype(np.uint8))
-            drifted.append(out.as_posix())
-        view["images"] = drifted
-    out = job_path.with_name(f"{look}{DRIFT}__{rest}")
-    out.write_text(json.dumps(job, indent=1))
-    return out
+    def drifted(img: np.ndarray, name: str) -> np.ndarray:
+        gain = drift_gain(int(Path(name).stem))
+        return np.clip(img * gain + 0.5, 0, 255).astype(np.uint8)
+
+    return _retouched_job(job_path, DRIFT, drifted)
 
 
 def look_cameras(clip_dir: Path, look: Look) -> dict[str, dict]:
