@@ -114,13 +114,14 @@ class Backdrop:
         k = np.ones((2 * self.margin + 1,) * 2, np.uint8)
         return cv2.dilate(body.astype(np.uint8), k) > 0
 
-    def learn(self, grey: np.ndarray, body: np.ndarray, colour: np.ndarray | None = None
-              ) -> None:
+    def learn(self, grey: np.ndarray, body: np.ndarray, colour: np.ndarray | None = None,
+              gain: float | None = None) -> None:
         """Take the backdrop from a tracked frame wherever it is still unseen and that frame's
-        body (its blobs' pixels) is not."""
+        body (its blobs' pixels) is not, at the backdrop's own exposure (``gain``: the
+        frame's ``exposure``, when already read)."""
         if grey.shape != self.image.shape:
             return
-        g = self.exposure(grey)  # taken at the backdrop's own exposure
+        g = self.exposure(grey) if gain is None else gain
         seen = self.unseen & ~self.widen(body)
         self.image[seen] = grey[seen] / g
         if self.colour is not None and colour is not None:
@@ -597,4 +598,4 @@ class SilhouetteCue:
         if isinstance(bd, TurningBackdrop):
             bd.learn(frame, *seen)
         else:
-            bd.learn(*seen)
+            bd.learn(*seen, gain=self.exposure(view, frame))
