@@ -47,7 +47,8 @@ def exposure_gain(frame: np.ndarray, backdrop: np.ndarray, usable: np.ndarray | 
     if not counts.any():
         return 1.0
     smooth = np.convolve(counts, np.ones(5), mode="same")  # a pile split across two bins
-    peak = 0.5 * (edges[np.argmax(smooth)] + edges[np.argmax(smooth) + 1])
+    top = int(np.argmax(smooth))
+    peak = 0.5 * (edges[top] + edges[top + 1])
     near = np.abs(ratio - peak) <= SPREAD
     gain = float(np.sum(f[near]) / np.sum(b[near]))
     return 1.0 if abs(np.log(gain)) < TOLERANCE else gain

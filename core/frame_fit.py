@@ -294,8 +294,6 @@ class FrameFit:
         """What to tell the user of the exposures the run followed (``SilhouetteCue.exposure``):
         each view whose footage was read at another exposure than its backdrop's, and how
         far; None where every frame's was the backdrop's."""
-        if not self._cue.started:
-            return None
         moved = [f"view {c + 1} {span[0]:.2f}-{span[1]:.2f}x" for c in range(self.seq.n_views)
                  if (span := self._cue.exposure_span(c)) not in (None, (1.0, 1.0))]
         if not moved:

@@ -87,22 +87,24 @@ class Backdrop:
         noise = np.abs(grey - cv2.medianBlur(grey, 3))[~self.unseen]
         self.threshold = max(MIN_CONTRAST, 6 * 1.4826 * float(np.median(noise)))
         frames = [(np.asarray(f, np.float32), c) for f, c in frames]
-        self.chroma_noise = self._chroma_noise(frames)
-        area = [np.count_nonzero(self.foreground(f, c) == FOREGROUND) for f, c in frames]
+        gains = [self.exposure(f) for f, _ in frames]
+        self.chroma_noise = self._chroma_noise(frames, gains)
+        area = [np.count_nonzero(self.foreground(f, c, gain=g) == FOREGROUND)
+                for (f, c), g in zip(frames, gains)]
         self.still = not area or float(np.median(area)) <= STILL_AREA_RATIO * max(
             int(body.sum()), 1)
 
-    def _chroma_noise(self, frames) -> float | None:
-        """The median colour distortion (``_chroma``) of frames against the backdrop over
-        the seen pixels they leave the same (every ``NOISE_STRIDE``-th row and column: a
-        median needs no more); None without colour frames to measure it."""
+    def _chroma_noise(self, frames, gains: list[float]) -> float | None:
+        """The median colour distortion (``_chroma``) of frames (grey, colour) against the
+        backdrop brought to their exposures ``gains`` over the seen pixels they leave the
+        same (every ``NOISE_STRIDE``-th row and column: a median needs no more); None
+        without colour frames to measure it."""
         if self.colour is None:
             return None
         k = NOISE_STRIDE
         found = [np.zeros(0)]
-        for grey, c in frames:
+        for (grey, c), g in zip(frames, gains):
             if c is not None and c.shape == self.colour.shape:
-                g = self.exposure(grey)
                 same = (np.abs(grey[::k, ::k] - g * self.image[::k, ::k]) <= self.threshold) \
                     & ~self.unseen[::k, ::k]
                 found.append(_chroma(c[::k, ::k][same], self.colour[::k, ::k][same])[0])
