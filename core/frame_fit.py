@@ -455,8 +455,10 @@ class FrameFit:
                 if not seen:
                     continue
                 out, dofs = cand, limb.dofs if seen > 1 else []
-            kept += [self.skeleton.names[j] for j, _, _ in dofs
-                     if not np.allclose(out.rotations[j], est.rotations[j])]
+            for j, _, _ in dofs:  # a ball's two swings name its joint once
+                name = self.skeleton.names[j]
+                if name not in kept and not np.allclose(out.rotations[j], est.rotations[j]):
+                    kept.append(name)
         return out, kept
 
     def scale_to(self, pose: BodyPose) -> None:

@@ -74,6 +74,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
                 "seconds": f.seconds,
                 "given": f.given,
                 "turned": None if f.turned is None else round(f.turned, 1),
+                "searched": list(f.searched),
                 "limbs": {name: {"confidence": round(c.confidence, 3), "flag": c.flag,
                                  "views": [None if v is None else round(v, 3)
                                            for v in c.views],

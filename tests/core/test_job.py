@@ -144,7 +144,8 @@ def test_the_report_is_strict_json_with_limb_checks_and_its_bvh_ends_before_a_di
                     given=True),
         FrameResult(frame=1, pose=job.initial, residual=0.01, iterations=3, converged=True,
                     limbs={"LeftKnee": LimbCheck(0.2, (0.2, None, 0.9)),
-                           "RightKnee": LimbCheck(0.8, (0.8, 0.9, 0.9))}),
+                           "RightKnee": LimbCheck(0.8, (0.8, 0.9, 0.9))},
+                    searched=["LeftHip"]),
         FrameResult(frame=2, pose=job.initial, residual=float("nan"), iterations=0,
                     converged=False, diverged=True, reason="the body left the image")])
     write_report(tmp_path / "report.json", report(job, result, 1.0))
@@ -154,6 +155,7 @@ def test_the_report_is_strict_json_with_limb_checks_and_its_bvh_ends_before_a_di
     assert (rep["frames_tracked"], rep["frames_total"]) == (1, 2)
     assert len(result_bvh(job, result).motion) == 2
     assert rep["frames_to_check"] == [1]
+    assert [f["searched"] for f in rep["frames"]] == [[], ["LeftHip"], []]
     assert rep["frames"][1]["limbs"] == {
         "LeftKnee": {"confidence": 0.2, "flag": "unsure", "views": [0.2, None, 0.9],
                      "unexplained": None},

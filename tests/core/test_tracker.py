@@ -850,7 +850,7 @@ def test_a_limb_the_search_turned_is_predicted_where_it_was_on_the_next_frame(bo
     frames = [[render(sk, p, c, noise=0.01, seed=i) for i, p in enumerate(
         [pose, jumped, jumped, jumped])] for c in range(3)]
     results = list(Tracker(sk, frames, CALIBRATED).iter_track(pose, [0, 1, 2, 3]))
-    assert "RightShoulder" in results[1].searched
+    assert results[1].searched.count("RightShoulder") == 1  # a ball's two swings, one joint
     assert _limb_errors(sk, results[1].pose, jumped).max() < 2.0
     assert results[2].searched == [] and results[3].searched == []
     assert max(_limb_errors(sk, r.pose, jumped).max() for r in results[2:]) < 2.0
