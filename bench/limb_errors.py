@@ -1,7 +1,7 @@
 """Where a tracked suite run loses, limb by limb and frame by frame.
 
     python bench/limb_errors.py JOB.json [--run "3 views 15 fps"] [--start N]
-                                [--twist JOINT,...] [--heading]
+                                [--twist JOINT,...] [--heading] [--jumps DEG]
 
 For a job ``bench/suite.py`` tracked (its ``.bvh`` beside it, the clip's ``truth.bvh`` in its
 folder): per frame of the run, each of the eight limbs' direction error against the capture,
@@ -14,13 +14,17 @@ fit, per frame: a body that turns can keep its trunk turned right while its pelv
 only by where the legs hang from it, lags, the lower back twisting to make up for it
 (``docs/RESEARCH.md``, forty-third session); and how far each frame's fit turned it from
 the tracker's constant-velocity prediction, beside how far the capture was from that
-prediction. ``--start`` is the frame the run started from
+prediction. With ``--jumps DEG``, the frames where a limb's error against the capture rose
+by more than DEG degrees in one frame, each with what moved it there: the limb search
+(the run's report names the joints it turned on each frame), the search turning the limb
+it hangs from, or the solver's steps alone. ``--start`` is the frame the run started from
 (``__from_N`` in the job's name).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -31,6 +35,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
+from captures import Parts  # noqa: E402
 from evaluate import swing_twist  # noqa: E402
 from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
 
@@ -82,6 +87,25 @@ def twist_rows(job, est: tuple, best: tuple, joint: str) -> np.ndarray:
     return np.array(out)
 
 
+def jumps(limbs: list, errors: np.ndarray, searched: list, rise: float) -> list[tuple]:
+    """Where a limb's error rose by more than ``rise`` degrees in one frame: (frame, limb,
+    error before, error after, what moved it). ``limbs`` (label, joint, end joint) the
+    scored limbs, ``errors`` (F, L) their errors, ``searched`` per frame the joints the limb
+    search turned (the report's); what moved it is ``search`` where the search turned the
+    limb's joint, ``search (parent)`` where it turned the joint of the limb it hangs from
+    (the one ending where it starts), else ``steps``."""
+    parent = {joint: next((j for _, j, end in limbs if end == joint), None)
+              for _, joint, _ in limbs}
+    out = []
+    for f, k in np.argwhere(np.diff(errors, axis=0) > rise):
+        label, joint, _ = limbs[k]
+        turned = set(searched[f + 1]) if f + 1 < len(searched) else set()
+        by = ("search" if joint in turned else
+              "search (parent)" if parent[joint] in turned else "steps")
+        out.append((int(f) + 1, label, float(errors[f, k]), float(errors[f + 1, k]), by))
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("job", type=Path, help="a job bench/suite.py tracked")
@@ -91,6 +115,9 @@ def main(argv=None) -> int:
     ap.add_argument("--heading", action="store_true",
                     help="the root's turn about the vertical against the capture and the "
                     "best fit")
+    ap.add_argument("--jumps", type=float, default=0.0, metavar="DEG",
+                    help="list the frames where a limb's error rose by more than DEG "
+                    "degrees, and whether the limb search moved it")
     args = ap.parse_args(argv)
     names, vs_truth, vs_best, job, est, truth, best = limb_errors(args.job, args.run,
                                                                    args.start)
@@ -112,6 +139,13 @@ def main(argv=None) -> int:
         print("  ".join(f"{a:+.1f}/{b:+.1f}" for a, b in zip(
             evaluate.heading_errors_deg(roots[0], pred)[1:],
             evaluate.heading_errors_deg(roots[1], pred)[1:])))
+    if args.jumps > 0:
+        report = json.loads(args.job.with_suffix(".report.json").read_text())
+        searched = [f.get("searched", []) for f in report["frames"]]
+        limbs = Parts.of(job.skeleton.names).limbs()[:len(names)]
+        print(f"a limb's error rising over {args.jumps:g} degrees in one frame:")
+        for f, label, before, after, by in jumps(limbs, vs_truth, searched, args.jumps):
+            print(f"  frame {f}: {label} {before:.0f} -> {after:.0f}, moved by the {by}")
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")

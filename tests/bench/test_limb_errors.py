@@ -59,3 +59,14 @@ def test_the_prediction_carries_the_last_step_on_and_starts_from_rest():
     np.testing.assert_allclose(pred[2:], roots[2:], atol=1e-12)
     half = predicted_roots(roots, gain=0.5)
     np.testing.assert_allclose(half[3], roots[2] @ _turn(AXIS, 6.0), atol=1e-12)
+
+
+def test_a_jump_is_told_moved_by_the_search_by_its_parents_turn_or_by_the_steps():
+    from limb_errors import jumps
+    limbs = [("thigh", "Hip", "Knee"), ("shank", "Knee", "Ankle"), ("arm", "Shoulder", "Elbow")]
+    errors = np.array([[0, 0, 0], [2, 40, 1], [3, 41, 50], [4, 90, 51], [4, 91, 52.0]])
+    searched = [[], ["Hip"], [], ["Knee"], []]
+    assert jumps(limbs, errors, searched, 30.0) == [
+        (1, "shank", 0.0, 40.0, "search (parent)"), (2, "arm", 1.0, 50.0, "steps"),
+        (3, "shank", 41.0, 90.0, "search")]
+    assert jumps(limbs, errors, searched, 60.0) == []
