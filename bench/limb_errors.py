@@ -35,7 +35,6 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import evaluate  # noqa: E402
-from captures import Parts  # noqa: E402
 from evaluate import swing_twist  # noqa: E402
 from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
 
@@ -43,19 +42,19 @@ from core.pose import BodyPose, extrapolate  # noqa: E402
 
 
 def limb_errors(job_path: Path, run: str, start: int) -> tuple:
-    """The run's eight limbs' names, and per frame their errors (F, 8) against the capture
-    and against the best fit, degrees; with the job, the tracked, the captured and the
-    best-fit poses."""
+    """The run's eight scored limbs (label, joint, end joint), and per frame their errors
+    (F, 8) against the capture and against the best fit, degrees; with the job, the
+    tracked, the captured and the best-fit poses."""
     job, limbs, est, truth = tracked_and_true(job_path, run, start)
     body, sight = fitted_body(job)
     best = evaluate.best_fit(body, truth, sight)
     sk = job.skeleton
-    names = [label for label, _, _ in limbs[:8]]
+    scored = limbs[:8]
     errors = []
     for ref in (truth, best):
         per = evaluate.limb_errors_deg(sk, est, ref, limbs)
-        errors.append(np.stack([per[n] for n in names], axis=1))
-    return names, errors[0], errors[1], job, est, truth, best
+        errors.append(np.stack([per[label] for label, _, _ in scored], axis=1))
+    return scored, errors[0], errors[1], job, est, truth, best
 
 
 def predicted_roots(roots: np.ndarray, gain: float = 1.0) -> np.ndarray:
@@ -119,8 +118,9 @@ def main(argv=None) -> int:
                     help="list the frames where a limb's error rose by more than DEG "
                     "degrees, and whether the limb search moved it")
     args = ap.parse_args(argv)
-    names, vs_truth, vs_best, job, est, truth, best = limb_errors(args.job, args.run,
+    limbs, vs_truth, vs_best, job, est, truth, best = limb_errors(args.job, args.run,
                                                                    args.start)
+    names = [label for label, _, _ in limbs]
     print("frame  " + "  ".join(f"{n[:12]:>12s}" for n in names) + "   (capture / best fit)")
     for f, (a, b) in enumerate(zip(vs_truth, vs_best)):
         print(f"{f:5d}  " + "  ".join(f"{x:5.1f} /{y:5.1f}" for x, y in zip(a, b)))
@@ -142,7 +142,6 @@ def main(argv=None) -> int:
     if args.jumps > 0:
         report = json.loads(args.job.with_suffix(".report.json").read_text())
         searched = [f.get("searched", []) for f in report["frames"]]
-        limbs = Parts.of(job.skeleton.names).limbs()[:len(names)]
         print(f"a limb's error rising over {args.jumps:g} degrees in one frame:")
         for f, label, before, after, by in jumps(limbs, vs_truth, searched, args.jumps):
             print(f"  frame {f}: {label} {before:.0f} -> {after:.0f}, moved by the {by}")
