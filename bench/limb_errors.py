@@ -2,6 +2,7 @@
 
     python bench/limb_errors.py JOB.json [--run "3 views 15 fps"] [--start N]
                                 [--twist JOINT,...] [--heading] [--jumps DEG]
+                                [--one-step {predicted,at-truth}]
 
 For a job ``bench/suite.py`` tracked (its ``.bvh`` beside it, the clip's ``truth.bvh`` in its
 folder): per frame of the run, each of the eight limbs' direction error against the capture,
@@ -17,8 +18,12 @@ the tracker's constant-velocity prediction, beside how far the capture was from 
 prediction. With ``--jumps DEG``, the frames where a limb's error against the capture rose
 by more than DEG degrees in one frame, each with what moved it there: the limb search
 (the run's report names the joints it turned on each frame), the search turning the limb
-it hangs from, or the solver's steps alone. ``--start`` is the frame the run started from
-(``__from_N`` in the job's name).
+it hangs from, or the solver's steps alone. With ``--one-step``, every frame tracked once
+more, alone, from the best fit of the frames before (``walk_benchmark.one_step_poses``;
+``at-truth``: predicted at the frame's own best fit), its root's heading against the best
+fit's, and the share of each frame's turn it leaves undone: a bias of the cost itself, apart
+from drift (``docs/RESEARCH.md``, fifty-seventh session). ``--start`` is the frame the run
+started from (``__from_N`` in the job's name).
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 import evaluate  # noqa: E402
 from evaluate import swing_twist  # noqa: E402
 from suite import RUNS, fitted_body, tracked_and_true  # noqa: E402
+from walk_benchmark import one_step_poses  # noqa: E402
 
 from core.pose import BodyPose, extrapolate  # noqa: E402
 
@@ -70,6 +76,15 @@ def predicted_roots(roots: np.ndarray, gain: float = 1.0) -> np.ndarray:
         before, last = (BodyPose(R[None], at, []) for R in roots[f - 2:f])
         out[f] = extrapolate(before, last, gain).rotations[0]
     return out
+
+
+def lag_share(beyond: np.ndarray, turn: np.ndarray) -> float:
+    """The share of each frame's turn a tracked heading leaves undone: the least-squares k
+    in ``beyond`` = -k ``turn`` (per frame, degrees the tracked root is turned beyond the
+    reference, and the reference's own turn since the frame before); NaN where nothing
+    turns."""
+    den = float(turn @ turn)
+    return float("nan") if den == 0 else -float(beyond @ turn) / den
 
 
 def twist_rows(job, est: tuple, best: tuple, joint: str) -> np.ndarray:
@@ -117,6 +132,9 @@ def main(argv=None) -> int:
     ap.add_argument("--jumps", type=float, default=0.0, metavar="DEG",
                     help="list the frames where a limb's error rose by more than DEG "
                     "degrees, and whether the limb search moved it")
+    ap.add_argument("--one-step", choices=("predicted", "at-truth"),
+                    help="track each frame once more from the best fit of the frames "
+                    "before, and read its heading against the best fit's")
     args = ap.parse_args(argv)
     limbs, vs_truth, vs_best, job, est, truth, best = limb_errors(args.job, args.run,
                                                                    args.start)
@@ -145,6 +163,18 @@ def main(argv=None) -> int:
         print(f"a limb's error rising over {args.jumps:g} degrees in one frame:")
         for f, label, before, after, by in jumps(limbs, vs_truth, searched, args.jumps):
             print(f"  frame {f}: {label} {before:.0f} -> {after:.0f}, moved by the {by}")
+    if args.one_step:
+        steps = one_step_poses(job, best, at_truth=args.one_step == "at-truth")
+        n = len(steps[0])
+        beyond = evaluate.heading_errors_deg(steps[0][:, 0], best[0][:n, 0])
+        turn = np.r_[0.0, evaluate.heading_errors_deg(best[0][1:n, 0], best[0][:n - 1, 0])]
+        per = evaluate.limb_errors_deg(job.skeleton, steps, (best[0][:n], best[1][:n]), limbs)
+        print(f"one step from the best fit ({args.one_step}): per frame, the root's heading "
+              "beyond the best fit's / the best fit's turn since the frame before, degrees")
+        print("  ".join(f"{a:+.1f}/{b:+.1f}" for a, b in zip(beyond[1:], turn[1:])))
+        print(f"  each frame's turn left undone: {lag_share(beyond[1:], turn[1:]):.2f}; "
+              "the eight limbs against the best fit: "
+              f"{np.mean([per[label][1:].mean() for label, _, _ in limbs]):.2f} degrees")
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")

@@ -77,31 +77,37 @@ RUNS = {
 }
 
 
-def one_step(job_path: Path, truth: tuple, at_truth: bool = False) -> evaluate.Scores:
-    """Each frame tracked alone from the true pose of the frame before, predicted from the true
-    poses of the two before (the first from the one before): how well a single step follows
-    the body, apart from how errors add up along the sequence. With ``at_truth`` the
-    prediction is the frame's own true pose: where the tracker's cost has its minimum, apart
-    from how far its prediction and search start from it."""
+def one_step_poses(job, poses: tuple, at_truth: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Each frame of ``job`` tracked alone from ``poses`` (rotations (F, J, 3, 3), roots
+    (F, 3): the truth, or its best fit) of the frame before, predicted from those of the two
+    before (the first from the one before), against frame 0's as the key frame: how well a
+    single step follows the body, apart from how errors add up along the sequence. With
+    ``at_truth`` the prediction is the frame's own pose: where the tracker's cost has its
+    minimum, apart from how far its prediction and search start from it. Returns the
+    tracked (rotations, roots), frame 0 the given one."""
     from core.pose import BodyPose, extrapolate
     from core.tracker import Tracker
 
-    job = load_job(job_path)
-    sk = job.skeleton
-    tracker = Tracker(sk, job.images, job.mode, job.settings)
+    tracker = Tracker(job.skeleton, job.images, job.mode, job.settings, job.moving or None)
 
     def pose(i):
-        return BodyPose(truth[0][i].copy(), truth[1][i].copy(), [c.copy() for c in job.cameras])
+        return BodyPose(poses[0][i].copy(), poses[1][i].copy(), [c.copy() for c in job.cameras])
 
-    est_R, est_p = [truth[0][0]], [truth[1][0]]
-    for i in range(1, len(truth[0])):
+    est_R, est_p = [poses[0][0]], [poses[1][0]]
+    for i in range(1, min(len(poses[0]), len(job.images[0]))):
         pred = (pose(i) if at_truth else pose(i - 1) if i == 1
                 else extrapolate(pose(i - 2), pose(i - 1)))
         res = tracker.track_frame(pose(i - 1), i - 1, pose(0), 0, pred, i)
         est_R.append(res.pose.rotations)
         est_p.append(res.pose.root_position)
-    tracked = sk.tracked_joint_names()
-    return evaluate.score(sk, tracked, (np.array(est_R), np.array(est_p)), truth)
+    return np.array(est_R), np.array(est_p)
+
+
+def one_step(job_path: Path, truth: tuple, at_truth: bool = False) -> evaluate.Scores:
+    """``one_step_poses`` of a job from the truth, scored against it."""
+    job = load_job(job_path)
+    tracked = job.skeleton.tracked_joint_names()
+    return evaluate.score(job.skeleton, tracked, one_step_poses(job, truth, at_truth), truth)
 
 
 # ``python -m core`` that writes, as it exits, its peak resident memory (Linux's VmHWM, in kB)

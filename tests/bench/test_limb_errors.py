@@ -70,3 +70,14 @@ def test_a_jump_is_told_moved_by_the_search_by_its_parents_turn_or_by_the_steps(
         (1, "shank", 0.0, 40.0, "search (parent)"), (2, "arm", 1.0, 50.0, "steps"),
         (3, "shank", 41.0, 90.0, "search")]
     assert jumps(limbs, errors, searched, 60.0) == []
+
+
+def test_the_share_of_each_turn_left_undone():
+    from limb_errors import lag_share
+    rng = np.random.default_rng(5)
+    turn = rng.uniform(-12.0, 12.0, 40)  # the reference's turn each frame, degrees
+    # a step that turns 85 % of the way, give or take a tenth of a degree
+    beyond = -0.15 * turn + rng.normal(0.0, 0.1, 40)
+    assert lag_share(beyond, turn) == pytest.approx(0.15, abs=0.01)
+    assert lag_share(0.2 * turn, turn) == pytest.approx(-0.2)  # a step that overturns
+    assert np.isnan(lag_share(np.ones(3), np.zeros(3)))  # nothing turned: nothing to share
