@@ -166,13 +166,14 @@ def main(argv=None) -> int:
     if args.one_step:
         steps = one_step_poses(job, best, at_truth=args.one_step == "at-truth")
         n = len(steps[0])
-        beyond = evaluate.heading_errors_deg(steps[0][:, 0], best[0][:n, 0])
-        turn = np.r_[0.0, evaluate.heading_errors_deg(best[0][1:n, 0], best[0][:n - 1, 0])]
+        # the tracked frames: frame 0 is the best fit's own
+        beyond = evaluate.heading_errors_deg(steps[0][1:, 0], best[0][1:n, 0])
+        turn = evaluate.heading_errors_deg(best[0][1:n, 0], best[0][:n - 1, 0])
         per = evaluate.limb_errors_deg(job.skeleton, steps, (best[0][:n], best[1][:n]), limbs)
         print(f"one step from the best fit ({args.one_step}): per frame, the root's heading "
               "beyond the best fit's / the best fit's turn since the frame before, degrees")
-        print("  ".join(f"{a:+.1f}/{b:+.1f}" for a, b in zip(beyond[1:], turn[1:])))
-        print(f"  each frame's turn left undone: {lag_share(beyond[1:], turn[1:]):.2f}; "
+        print("  ".join(f"{a:+.1f}/{b:+.1f}" for a, b in zip(beyond, turn)))
+        print(f"  each frame's turn left undone: {lag_share(beyond, turn):.2f}; "
               "the eight limbs against the best fit: "
               f"{np.mean([per[label][1:].mean() for label, _, _ in limbs]):.2f} degrees")
     for joint in filter(None, args.twist.split(",")):
