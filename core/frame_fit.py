@@ -563,10 +563,9 @@ class FrameFit:
             np.where(blob >= 0, self._limbs.of_blob[blob], -1)]
         if not limb.any():
             return limb
-        far = self._cue.distance_to_body(view, frame, lv)
         out = np.zeros(len(blob), bool)
         px = pix[limb].astype(int)
-        out[limb] = far[px[:, 1], px[:, 0]] > LOST_REACH
+        out[limb] = ~self._cue.near_body(view, frame, lv, px[:, 0], px[:, 1], LOST_REACH)
         return out
 
     def _label_maps(self, pose: BodyPose, kin: Kinematics, shapes: list, lvs: list[int],

@@ -395,6 +395,24 @@ def distance_to_body(fg: np.ndarray) -> np.ndarray:
                                  cv2.DIST_MASK_PRECISE)
 
 
+def near_body(fg: np.ndarray, xs: np.ndarray, ys: np.ndarray, reach: float) -> np.ndarray:
+    """Whether a pixel that may be the body (foreground or unsure) lies within ``reach``
+    pixels (straight-line) of each pixel (xs, ys) of a foreground map (H, W): the map's
+    ``distance_to_body`` at most ``reach`` there, read from the pixels that near alone
+    rather than a distance transform of the whole map."""
+    r = int(np.floor(reach))
+    h, w = fg.shape
+    out = np.zeros(len(xs), bool)
+    for dy in range(-r, r + 1):
+        for dx in range(-r, r + 1):
+            if dx * dx + dy * dy > reach * reach:
+                continue
+            x, y = xs + dx, ys + dy
+            inside = np.flatnonzero((x >= 0) & (x < w) & (y >= 0) & (y < h))
+            out[inside] |= fg[y.take(inside), x.take(inside)] != BACKDROP
+    return out
+
+
 class NearestPixel:
     """Where the nearest pixel of a mask (H, W) is from any pixel: one distance transform,
     made when first asked and then looked up (a level's foreground, against which every
@@ -557,6 +575,11 @@ class SilhouetteCue:
     def distance_to_body(self, view: int, frame: int, level: int = 0) -> np.ndarray:
         """``distance_to_body`` of ``foreground``'s map, kept with it."""
         return self._maps(view, frame).distance(level)
+
+    def near_body(self, view: int, frame: int, level: int, xs: np.ndarray, ys: np.ndarray,
+                  reach: float) -> np.ndarray:
+        """``near_body`` of ``foreground``'s map at level pixels (xs, ys)."""
+        return near_body(self.foreground(view, frame, level), xs, ys, reach)
 
     def _maps(self, view: int, frame: int) -> LevelMaps:
         """``frame``'s foreground maps in ``view``, made when first asked for."""

@@ -560,3 +560,18 @@ def test_a_lost_limb_is_not_held_on_a_still_backdrop_by_the_backdrops_pixels(rel
         pose, doubted = res.pose, {n for n, c in res.limbs.items() if c.flag}
     assert last_link_off(lost) > 45
     assert (last_link_off(pose) < 35) if release else (last_link_off(pose) > 45)
+
+
+@pytest.mark.parametrize("reach", [0.5, 1.0, 1.5, 2.9, 4.0])
+def test_near_body_reads_the_distance_to_the_body_from_the_pixels_within_reach(reach):
+    """Against the whole map's distance transform: the same answer at every pixel, the
+    image's edges and unsure pixels included."""
+    rng = np.random.default_rng(int(reach * 10))
+    fg = np.zeros((40, 50), np.uint8)
+    fg[rng.random(fg.shape) < 0.03] = silhouette.FOREGROUND
+    fg[rng.random(fg.shape) < 0.01] = silhouette.UNSURE
+    ys, xs = np.mgrid[0:40, 0:50]
+    far = silhouette.distance_to_body(fg)
+    got = silhouette.near_body(fg, xs.ravel(), ys.ravel(), reach)
+    assert np.array_equal(got, far.ravel() <= reach)
+    assert got.any() and not got.all()
