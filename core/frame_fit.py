@@ -479,6 +479,15 @@ class FrameFit:
         covered = self._label_maps(pose, kin, [shape], [0], [g], [view])[0][0] >= 0
         return np.repeat(np.repeat(covered, g, 0), g, 1)[:shape[0], :shape[1]]
 
+    def key_sets_made(self, key_frame: int) -> bool:
+        """Whether the key frame's point sets are made in every view on every level the
+        tracker reads (``key_sets``): then tracking reads none of its images again (its
+        backdrops are made on the first frame after it), and they need not be kept (read
+        again if the body's scale changes and they are needed)."""
+        return all((key_frame, c, lv) in self.key_sets
+                   for level in range(self.scales.n_levels())
+                   for c, lv in enumerate(self.scales.view_levels(level)))
+
     def _learn_backdrops(self, res: FrameResult) -> None:
         """Let each view's backdrop see behind where the body was on an earlier frame, now
         that the tracked pose says where it is not."""

@@ -265,8 +265,9 @@ class Tracker(FrameFit):
                 self.notes.append(note)
             if np.isfinite(res.residual):
                 residuals.append(res.residual)
-            self.seq.keep_only({(c, f) for c in range(self.seq.n_views)
-                                for f in (key_frame, prev.frame, frame)})
+            kept = (prev.frame, frame) if self.key_sets_made(key_frame) else \
+                (key_frame, prev.frame, frame)
+            self.seq.keep_only({(c, f) for c in range(self.seq.n_views) for f in kept})
             yield res
             if res.diverged and self.settings.stop_on_divergence:
                 return

@@ -955,3 +955,24 @@ def test_a_note_names_the_hinges_that_start_outside_their_limits():
     pose.rotations[knee] = se3.exp_so3(np.radians(-20) * sk.axes[knee])  # bent forward
     notes = track(Tracker(sk, frames, CALIBRATED), pose, [0, 1]).notes
     assert len(notes) == 1 and notes[0].startswith("LeftKnee starts bent outside")
+
+
+def test_the_key_frames_images_are_let_go_once_its_point_sets_are_made(body):
+    """Once every view's key point set is made on every level (the second frame after the
+    key), tracking reads nothing more of the key frame, and its pyramids and images are not
+    kept: only the previous and current frames' (and the one read ahead)."""
+    sk, pose = body
+    poses = [pose]
+    for seed in (2, 3, 5):
+        poses.append(apply_update(sk, poses[-1], _small_motion(sk, CALIBRATED, 3, seed) * 0.5,
+                                  CALIBRATED))
+    frames = [[render(sk, p, c, noise=0.005, seed=i) for i, p in enumerate(poses)]
+              for c in range(3)]
+    tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=4))
+    kept = []
+    for res in tracker.iter_track(pose, [0, 1, 2, 3]):
+        assert not res.diverged
+        kept.append({f for _, f in tracker.seq._pyramids} | {f for _, f in tracker.seq._grey})
+    assert 0 in kept[1]  # the next frame makes the key point sets from it
+    assert tracker.key_sets_made(0)
+    assert 0 not in kept[2] | kept[3] and kept[3] <= {2, 3}
