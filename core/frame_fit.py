@@ -558,7 +558,7 @@ class FrameFit:
         g = kin.segments.take(seg_joint, 0)
         d = hits.world[ok] - g[:, :3, 3]
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
-        value = level.stack[pix_l[:, 1], pix_l[:, 0], :level.channels].astype(float)
+        value = level.values(pix_l).astype(float)
         rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
         return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
 

@@ -10,8 +10,10 @@ which rounds sample positions to 1/32 pixel.
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -205,38 +207,110 @@ def with_chroma(grey: np.ndarray, colour: np.ndarray) -> np.ndarray:
     return np.dstack([grey, ycrcb[..., 1:]])
 
 
+STACK_REACH = 20  # level pixels around a pixel its stack entry reads of the level's image:
+# the blur's 3, the shading filter's 16 (``pyramid``'s defaults) and the gradient's 1
+
+
 @dataclass
 class Level:
     """One pyramid level: the image's C channels, then their x derivatives, then their y
-    derivatives, stacked (H, W, 3 C), float32."""
+    derivatives, stacked (rows, cols, 3 C), float32. A level built over a window of the
+    image holds the stack there alone: its (rows, cols) start at level pixel ``origin`` (x,
+    y) of the level's whole ``size`` (H, W), and ``widen`` builds it over the whole level
+    when a read falls outside (reading the frame again)."""
 
     stack: np.ndarray
     scale: float  # full-resolution pixels per level pixel
+    origin: tuple[int, int] = (0, 0)
+    size: tuple[int, int] | None = None  # the whole level's (H, W); None: the stack's
+    whole: Callable[[], np.ndarray] | None = None  # the stack over the whole level
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.stack.shape[:2]
+        """The whole level's (H, W)."""
+        return self.size if self.size is not None else self.stack.shape[:2]
 
     @property
     def channels(self) -> int:
         return self.stack.shape[2] // 3
 
+    def holding(self, x: np.ndarray, y: np.ndarray, reach: int) -> Level:
+        """This level, widened to the whole level first if the stack lacks a pixel within
+        ``reach`` (0 or 1) pixels right of and below level pixels (x, y) (floats or ints)
+        that lie in the level; the edges of the level itself are the stack's own."""
+        if self.whole is None or not len(x):
+            return self
+        H, W = self.shape
+        (x0, y0), (h, w) = self.origin, self.stack.shape[:2]
+        inside = (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
+        fx, fy = np.floor(x[inside]) - x0, np.floor(y[inside]) - y0
+        last_x = w - 1 if x0 + w == W else w - 1 - reach
+        last_y = h - 1 if y0 + h == H else h - 1 - reach
+        if len(fx) and (fx.min() < 0 or fy.min() < 0 or fx.max() > last_x
+                        or fy.max() > last_y):
+            self.stack, self.origin, self.size, self.whole = self.whole(), (0, 0), None, None
+        return self
 
-def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0.0) -> list[Level]:
+    def values(self, pixels: np.ndarray) -> np.ndarray:
+        """The channels' values (N, C) at integer level pixels (N, 2) = (x, y) in the level."""
+        self.holding(pixels[:, 0], pixels[:, 1], 0)
+        x0, y0 = self.origin
+        return self.stack[pixels[:, 1] - y0, pixels[:, 0] - x0, :self.channels]
+
+
+def _stack(cur: np.ndarray, blur: float, highpass: float) -> np.ndarray:
+    """A level's image (rows, cols[, C]) smoothed and filtered (``pyramid``), with its x and y
+    derivatives, stacked (rows, cols, 3 C)."""
+    sm = cv2.GaussianBlur(cur, (0, 0), blur) if blur > 0 else cur
+    if highpass > 0:
+        sm = sm - cv2.GaussianBlur(sm, (0, 0), highpass)
+    gx = cv2.Sobel(sm, cv2.CV_32F, 1, 0, ksize=3, scale=1 / 8)
+    gy = cv2.Sobel(sm, cv2.CV_32F, 0, 1, ksize=3, scale=1 / 8)
+    return np.dstack([sm, gx, gy])
+
+
+def _whole_stack(image: Callable[[], np.ndarray], level: int, blur: float, highpass: float
+                 ) -> np.ndarray:
+    """Level ``level``'s stack over the whole of ``image()`` (``pyramid``'s own numbers)."""
+    cur = image()
+    for _ in range(level):
+        cur = cv2.pyrDown(cur)
+    return _stack(cur, blur, highpass)
+
+
+def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0.0,
+            window: tuple[int, int, int, int] | None = None,
+            again: Callable[[], np.ndarray] | None = None) -> list[Level]:
     """Gaussian pyramid with derivatives of a grey image (H, W) or a stack of channels
     (H, W, C), finest level first; each level lightly pre-smoothed
     (sigma ``blur`` level pixels) so that gradients see past the sensor noise, and, when
     ``highpass`` > 0, stripped of its local mean over that sigma (level pixels) so that slow
-    shading changes across a turning limb do not read as motion."""
+    shading changes across a turning limb do not read as motion. With ``window`` (x0, y0,
+    x1, y1, full-resolution pixels), each level's stack is made over that window only (each
+    level's image itself is the whole image's, halved from it), the same numbers there as
+    over the whole level: the filters read ``STACK_REACH`` level pixels round each one.
+    ``again`` gives ``img`` once more when a level is widened (``Level.whole``; None: the
+    levels keep ``img``)."""
+    if window is not None and max(blur, highpass) > 6:
+        window = None  # filters wider than ``STACK_REACH`` provides for
     out = []
     cur = img
     for lv in range(levels):
-        sm = cv2.GaussianBlur(cur, (0, 0), blur) if blur > 0 else cur
-        if highpass > 0:
-            sm = sm - cv2.GaussianBlur(sm, (0, 0), highpass)
-        gx = cv2.Sobel(sm, cv2.CV_32F, 1, 0, ksize=3, scale=1 / 8)
-        gy = cv2.Sobel(sm, cv2.CV_32F, 0, 1, ksize=3, scale=1 / 8)
-        out.append(Level(np.dstack([sm, gx, gy]), float(2**lv)))
+        if window is None:
+            out.append(Level(_stack(cur, blur, highpass), float(2**lv)))
+        else:
+            H, W = cur.shape[:2]
+            x0, y0 = (max(0, int(np.floor(v / 2**lv))) for v in window[:2])
+            x1, y1 = min(W, int(np.ceil(window[2] / 2**lv)) + 1), \
+                min(H, int(np.ceil(window[3] / 2**lv)) + 1)
+            # the filters read STACK_REACH round every pixel: a border of it, cut off after
+            bx0, by0 = max(0, x0 - STACK_REACH), max(0, y0 - STACK_REACH)
+            bx1, by1 = min(W, x1 + STACK_REACH), min(H, y1 + STACK_REACH)
+            part = _stack(cur[by0:by1, bx0:bx1], blur, highpass)
+            out.append(Level(np.ascontiguousarray(part[y0 - by0:y1 - by0, x0 - bx0:x1 - bx0]),
+                             float(2**lv), (x0, y0), (H, W),
+                             functools.partial(_whole_stack, again or (lambda: img), lv, blur,
+                                               highpass)))
         if lv + 1 < levels:
             cur = cv2.pyrDown(cur)
     return out
@@ -265,6 +339,10 @@ def sample(level: Level, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     C = level.channels
     if N == 0:
         return np.zeros((0, 3 * C), np.float32), inside
+    level.holding(p[:, 0], p[:, 1], 2)  # a sample reads the next pixel too (and its weight
+    # is rounded, so a little more)
+    if level.origin != (0, 0):  # exact: an integer off a float under 2^24 that exceeds it
+        p = p - np.array(level.origin, np.float32)
     cols = min(N, _REMAP_COLS)
     rows = -(-N // cols)
     maps = np.zeros((rows * cols, 2), np.float32)  # remap takes a 2-D map; pad the tail

@@ -83,13 +83,17 @@ class ImageSequence:
         self._pyramids.clear()
         self.levels = list(levels)
 
-    def read_ahead(self, frame: int) -> None:
-        """Start reading every view's ``frame`` and building its pyramids in the background."""
+    def read_ahead(self, frame: int, windows: Sequence | None = None) -> None:
+        """Start reading every view's ``frame`` and building its pyramids in the background;
+        ``windows``: per view, the full-resolution box (x0, y0, x1, y1) where the body is
+        expected, or None (the pyramids' stacks are made there alone, ``image.pyramid``,
+        and over the whole image when a read falls outside it)."""
         if frame in self._ahead or all((c, frame) in self._pyramids
                                        for c in range(self.n_views)):
             return
+        windows = list(windows) if windows is not None else [None] * self.n_views
         self._ahead[frame] = self._reader.submit(
-            lambda: [(g, rgb, self._build(c, g, rgb)) for c, (g, rgb) in
+            lambda: [(g, rgb, self._build(c, g, rgb, frame, windows[c])) for c, (g, rgb) in
                      ((c, self._read(c, frame)) for c in range(self.n_views))])
 
     def keep_only(self, keys: set[tuple[int, int]]) -> None:
@@ -111,7 +115,16 @@ class ImageSequence:
     def _read(self, view: int, frame: int) -> tuple[np.ndarray, np.ndarray | None]:
         return imagelib.grey_and_colour(self.images[view][frame])
 
-    def _build(self, view: int, grey: np.ndarray, colour: np.ndarray | None
+    def _build(self, view: int, grey: np.ndarray, colour: np.ndarray | None,
+               frame: int | None = None, window: tuple | None = None
                ) -> list[imagelib.Level]:
-        img = grey if colour is None or not self.chroma else imagelib.with_chroma(grey, colour)
-        return imagelib.pyramid(img, self.levels[view], highpass=self.highpass)
+        """The pyramid of a frame's (grey, colour); over ``window`` alone (``image.pyramid``),
+        the frame read again from its file when a level is widened."""
+        img = self._image(grey, colour)
+        again = None if window is None else lambda: self._image(*self._read(view, frame))
+        return imagelib.pyramid(img, self.levels[view], highpass=self.highpass, window=window,
+                                again=again)
+
+    def _image(self, grey: np.ndarray, colour: np.ndarray | None) -> np.ndarray:
+        """What the pyramids are made of: the grey image, or its stack with the chroma."""
+        return grey if colour is None or not self.chroma else imagelib.with_chroma(grey, colour)

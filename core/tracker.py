@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import image as imagelib
-from . import se3
+from . import raycast, se3
 from .blas import one_blas_thread
 from .camera import Camera
 from .confidence import UNSEEN, UNSURE_FLAG
@@ -37,6 +37,11 @@ from .skeleton import Skeleton
 from .solver import DegenerateSystem
 
 MIN_LEVEL_PIXELS = 16  # the coarsest pyramid level keeps images at least this large
+READ_REACH = 0.2  # of the body's larger side in a view: how far round its outline on the
+# last tracked frame a frame read ahead has its pyramids' stacks made (the rest when read)
+WHOLE_SHARE = 0.6  # of a view's image: a window over more than this is the whole image
+WINDOW_FROM = 1_000_000  # pixels: smaller images are made whole (their pyramids cost less
+# than checking every read against a window: 480x360 views track 0.97 times as fast)
 
 
 def frames_tracked(results: Sequence[FrameResult]) -> int:
@@ -244,9 +249,9 @@ class Tracker(FrameFit):
         history = [first]
         residuals: list[float] = []
         for i, frame in enumerate(frames[1:], 1):
-            if i + 1 < len(frames):
-                self.seq.read_ahead(frames[i + 1])
             prev = history[-1]
+            if i + 1 < len(frames):
+                self.seq.read_ahead(frames[i + 1], self._read_windows(prev.pose, prev.frame))
             if frame in corrections:
                 key_frame, key = frame, self._filmed_from(corrections[frame], frame).copy()
                 self.key_sets.clear()
@@ -272,6 +277,28 @@ class Tracker(FrameFit):
             if res.diverged and self.settings.stop_on_divergence:
                 return
             history = history[-1:] + [res]
+
+    def _read_windows(self, pose: BodyPose, frame: int) -> list[tuple | None]:
+        """Per view, where the body should lie on a frame read ahead of ``frame`` (tracked
+        at ``pose``): its blobs' outline there widened by ``READ_REACH`` of its larger side,
+        as a full-resolution box (x0, y0, x1, y1); None for a view whose camera moves, or
+        where the image is small (``WINDOW_FROM``) or the box covers most of it
+        (``WHOLE_SHARE``)."""
+        kin = Kinematics(self.skeleton, pose)
+        out: list[tuple | None] = []
+        for c, view in enumerate(pose.views):
+            H, W = self.seq.grey(c, frame).shape
+            boxes = raycast.blob_boxes(view, self._blobs, kin.segments)
+            lo, hi = boxes[:, :2].min(0), boxes[:, 2:].max(0)
+            reach = READ_REACH * float(np.max(hi - lo))
+            (x0, y0), (x1, y1) = np.maximum(lo - reach, 0), np.minimum(hi + reach, (W, H))
+            if self.moving[c] is not None or W * H < WINDOW_FROM or \
+                    not np.all(np.isfinite([x0, y0, x1, y1])) or x1 <= x0 or y1 <= y0 or \
+                    (x1 - x0) * (y1 - y0) > WHOLE_SHARE * W * H:
+                out.append(None)
+            else:
+                out.append((int(x0), int(y0), int(np.ceil(x1)), int(np.ceil(y1))))
+        return out
 
     def _next_frame(self, history: list[FrameResult], key: BodyPose, key_frame: int,
                     frame: int, residuals: list[float]) -> FrameResult:

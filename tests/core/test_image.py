@@ -113,3 +113,65 @@ def test_chroma_channels_read_hue_and_are_even_for_grey():
     np.testing.assert_array_equal(out[..., 0], grey)
     np.testing.assert_allclose(out[0, 0, 1:], 0.5, atol=1e-6)  # grey: no hue
     assert out[0, 1, 1] > 0.9 and out[0, 2, 2] > 0.9  # red: Cr, blue: Cb
+
+
+@pytest.mark.parametrize("channels", [None, 3])
+@pytest.mark.parametrize("window", [(70, 40, 150, 130), (0, 0, 60, 50), (120, 90, 333, 251)])
+def test_a_pyramid_made_over_a_window_is_the_whole_ones_there(channels, window):
+    """Every level's stack over the window (with the shading filter and odd sizes) is the
+    whole image's to the bit; its shape is the whole level's."""
+    rng = np.random.default_rng(7)
+    shape = (251, 333) if channels is None else (251, 333, channels)
+    img = cv2.GaussianBlur(rng.random(shape).astype(np.float32), (0, 0), 1.5)
+    whole = image.pyramid(img, 4, highpass=4.0)
+    part = image.pyramid(img, 4, highpass=4.0, window=window)
+    for lv, (a, b) in enumerate(zip(whole, part, strict=True)):
+        assert b.shape == a.shape and b.scale == a.scale and b.channels == a.channels
+        (x0, y0), (h, w) = b.origin, b.stack.shape[:2]
+        assert x0 <= window[0] / 2**lv and y0 <= window[1] / 2**lv
+        assert x0 + w >= min(window[2] / 2**lv, a.shape[1])
+        assert y0 + h >= min(window[3] / 2**lv, a.shape[0])
+        np.testing.assert_array_equal(b.stack, a.stack[y0:y0 + h, x0:x0 + w])
+
+
+def test_reading_a_windowed_level_outside_its_window_widens_it_and_reads_the_same():
+    """Samples and pixel values anywhere in the image are the whole pyramid's, bit for bit:
+    inside the window from the window's stack, outside after the level is made whole
+    (from the image given again); a read inside leaves the window as it is."""
+    rng = np.random.default_rng(3)
+    img = cv2.GaussianBlur(rng.random((200, 240, 3)).astype(np.float32), (0, 0), 1.5)
+    whole = image.pyramid(img, 3, highpass=4.0)
+    asked = []
+
+    def again():
+        asked.append(1)
+        return img
+
+    part = image.pyramid(img, 3, highpass=4.0, window=(80, 60, 160, 140), again=again)
+    near = rng.uniform((90, 70), (150, 130), (500, 2))  # full-resolution pixels
+    for a, b in zip(whole, part):
+        np.testing.assert_array_equal(image.sample(b, near)[0], image.sample(a, near)[0])
+    assert all(b.whole is not None for b in part) and not asked
+    anywhere = np.concatenate([near, rng.uniform((-5, -5), (245, 205), (500, 2))])
+    for a, b in zip(whole, part):
+        got, inside = image.sample(b, anywhere)
+        want, inside_whole = image.sample(a, anywhere)
+        np.testing.assert_array_equal(inside, inside_whole)
+        np.testing.assert_array_equal(got[inside], want[inside])
+        assert b.whole is None and b.origin == (0, 0)
+    assert len(asked) == 3
+    part = image.pyramid(img, 3, highpass=4.0, window=(80, 60, 160, 140))
+    pix = np.array([[0, 0], [239, 199], [100, 100]])
+    np.testing.assert_array_equal(part[0].values(pix), whole[0].stack[pix[:, 1], pix[:, 0], :3])
+
+
+def test_a_sample_between_a_window_s_last_pixel_and_the_next_widens_the_level():
+    rng = np.random.default_rng(5)
+    img = cv2.GaussianBlur(rng.random((120, 160)).astype(np.float32), (0, 0), 1.5)
+    whole = image.pyramid(img, 1, highpass=4.0)[0]
+    for side in (0, 1):  # right, then bottom
+        part = image.pyramid(img, 1, highpass=4.0, window=(40, 30, 90, 80))[0]
+        (x0, y0), (h, w) = part.origin, part.stack.shape[:2]
+        edge = np.array([[x0 + w - 0.5, y0 + 10.0] if side == 0 else [x0 + 10.0, y0 + h - 0.5]])
+        np.testing.assert_array_equal(image.sample(part, edge)[0], image.sample(whole, edge)[0])
+        assert part.whole is None

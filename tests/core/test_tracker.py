@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
+import core.tracker as tracker_module
 from core import blas, raycast, se3
+from core import image as imagelib
 from core import silhouette as sil
 from core.camera import View
 from core.confidence import LimbCheck
@@ -976,3 +978,53 @@ def test_the_key_frames_images_are_let_go_once_its_point_sets_are_made(body):
     assert 0 in kept[1]  # the next frame makes the key point sets from it
     assert tracker.key_sets_made(0)
     assert 0 not in kept[2] | kept[3] and kept[3] <= {2, 3}
+
+
+def test_frames_read_ahead_over_the_body_s_window_track_as_over_the_whole_image(
+        body, monkeypatch):
+    """A frame read ahead has its pyramids' stacks made round where the body was (the
+    rest when a read falls outside): the run is the same to the bit as one whose stacks
+    cover the whole images, even with windows so tight that levels are widened."""
+    sk, pose = body
+    poses = [pose]
+    for seed in (2, 3, 5, 6):
+        poses.append(apply_update(sk, poses[-1], _small_motion(sk, CALIBRATED, 3, seed),
+                                  CALIBRATED))
+    frames = [[render(sk, p, c, noise=0.005, seed=i) for i, p in enumerate(poses)]
+              for c in range(3)]
+
+    def run():
+        return track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=4)), pose,
+                     list(range(len(poses))))
+
+    monkeypatch.setattr(tracker_module, "WHOLE_SHARE", 0.0)  # never a window
+    whole = run()
+    windows, widened = [], []
+    built = imagelib.pyramid
+
+    def pyramid(*args, **kw):
+        levels = built(*args, **kw)
+        windows.append(kw.get("window"))
+        return levels
+
+    holding = imagelib.Level.holding
+
+    def watched(self, x, y, reach):
+        was = self.whole is not None
+        out = holding(self, x, y, reach)
+        widened.append(was and self.whole is None)
+        return out
+
+    monkeypatch.setattr(imagelib, "pyramid", pyramid)
+    monkeypatch.setattr(imagelib.Level, "holding", watched)
+    monkeypatch.setattr(tracker_module, "WHOLE_SHARE", 1.0)
+    monkeypatch.setattr(tracker_module, "WINDOW_FROM", 0)  # the test's small images too
+    for reach, widens in ((0.3, False), (0.0, True)):
+        monkeypatch.setattr(tracker_module, "READ_REACH", reach)
+        windows.clear()
+        widened.clear()
+        windowed = run()
+        assert sum(w is not None for w in windows) >= 6 and any(widened) == widens
+        for a, b in zip(whole.frames, windowed.frames, strict=True):
+            np.testing.assert_array_equal(a.pose.rotations, b.pose.rotations)
+            np.testing.assert_array_equal(a.pose.root_position, b.pose.root_position)
