@@ -207,8 +207,6 @@ def with_chroma(grey: np.ndarray, colour: np.ndarray) -> np.ndarray:
     return np.dstack([grey, ycrcb[..., 1:]])
 
 
-STACK_REACH = 20  # level pixels around a pixel its stack entry reads of the level's image:
-# the blur's 3, the shading filter's 16 (``pyramid``'s defaults) and the gradient's 1
 
 
 @dataclass
@@ -258,6 +256,19 @@ class Level:
         return self.stack[pixels[:, 1] - y0, pixels[:, 0] - x0, :self.channels]
 
 
+def _blur_reach(sigma: float) -> int:
+    """Pixels each side that OpenCV's Gaussian blur of ``sigma`` reads in a float image (its
+    kernel 8 sigma + 1 wide, rounded, odd); 0 for no blur."""
+    return (round(sigma * 8 + 1) | 1) // 2 if sigma > 0 else 0
+
+
+def stack_reach(blur: float, highpass: float) -> int:
+    """Level pixels round a pixel that its stack entry (``_stack``) reads of the level's
+    image: the blur's, the shading filter's and the gradient's one (20 at ``pyramid``'s
+    defaults and the tracker's highpass of 4)."""
+    return _blur_reach(blur) + _blur_reach(highpass) + 1
+
+
 def _stack(cur: np.ndarray, blur: float, highpass: float) -> np.ndarray:
     """A level's image (rows, cols[, C]) smoothed and filtered (``pyramid``), with its x and y
     derivatives, stacked (rows, cols, 3 C)."""
@@ -288,11 +299,10 @@ def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0
     shading changes across a turning limb do not read as motion. With ``window`` (x0, y0,
     x1, y1, full-resolution pixels), each level's stack is made over that window only (each
     level's image itself is the whole image's, halved from it), the same numbers there as
-    over the whole level: the filters read ``STACK_REACH`` level pixels round each one.
+    over the whole level: the filters read ``stack_reach`` level pixels round each one.
     ``again`` gives ``img`` once more when a level is widened (``Level.whole``; None: the
     levels keep ``img``)."""
-    if window is not None and max(blur, highpass) > 6:
-        window = None  # filters wider than ``STACK_REACH`` provides for
+    reach = stack_reach(blur, highpass)
     out = []
     cur = img
     for lv in range(levels):
@@ -303,9 +313,9 @@ def pyramid(img: np.ndarray, levels: int, blur: float = 0.8, highpass: float = 0
             x0, y0 = (max(0, int(np.floor(v / 2**lv))) for v in window[:2])
             x1, y1 = min(W, int(np.ceil(window[2] / 2**lv)) + 1), \
                 min(H, int(np.ceil(window[3] / 2**lv)) + 1)
-            # the filters read STACK_REACH round every pixel: a border of it, cut off after
-            bx0, by0 = max(0, x0 - STACK_REACH), max(0, y0 - STACK_REACH)
-            bx1, by1 = min(W, x1 + STACK_REACH), min(H, y1 + STACK_REACH)
+            # the filters read ``reach`` round every pixel: a border of it, cut off after
+            bx0, by0 = max(0, x0 - reach), max(0, y0 - reach)
+            bx1, by1 = min(W, x1 + reach), min(H, y1 + reach)
             part = _stack(cur[by0:by1, bx0:bx1], blur, highpass)
             out.append(Level(np.ascontiguousarray(part[y0 - by0:y1 - by0, x0 - bx0:x1 - bx0]),
                              float(2**lv), (x0, y0), (H, W),

@@ -117,14 +117,16 @@ def test_chroma_channels_read_hue_and_are_even_for_grey():
 
 @pytest.mark.parametrize("channels", [None, 3])
 @pytest.mark.parametrize("window", [(70, 40, 150, 130), (0, 0, 60, 50), (120, 90, 333, 251)])
-def test_a_pyramid_made_over_a_window_is_the_whole_ones_there(channels, window):
-    """Every level's stack over the window (with the shading filter and odd sizes) is the
-    whole image's to the bit; its shape is the whole level's."""
+@pytest.mark.parametrize("blur, highpass", [(0.8, 4.0), (1.3, 7.2), (0.8, 0.0)])
+def test_a_pyramid_made_over_a_window_is_the_whole_ones_there(channels, window, blur,
+                                                              highpass):
+    """Every level's stack over the window (with or without the shading filter, of any
+    width, and odd sizes) is the whole image's to the bit; its shape is the whole level's."""
     rng = np.random.default_rng(7)
     shape = (251, 333) if channels is None else (251, 333, channels)
     img = cv2.GaussianBlur(rng.random(shape).astype(np.float32), (0, 0), 1.5)
-    whole = image.pyramid(img, 4, highpass=4.0)
-    part = image.pyramid(img, 4, highpass=4.0, window=window)
+    whole = image.pyramid(img, 4, blur=blur, highpass=highpass)
+    part = image.pyramid(img, 4, blur=blur, highpass=highpass, window=window)
     for lv, (a, b) in enumerate(zip(whole, part, strict=True)):
         assert b.shape == a.shape and b.scale == a.scale and b.channels == a.channels
         (x0, y0), (h, w) = b.origin, b.stack.shape[:2]
