@@ -207,15 +207,13 @@ def with_chroma(grey: np.ndarray, colour: np.ndarray) -> np.ndarray:
     return np.dstack([grey, ycrcb[..., 1:]])
 
 
-
-
 @dataclass
 class Level:
     """One pyramid level: the image's C channels, then their x derivatives, then their y
     derivatives, stacked (rows, cols, 3 C), float32. A level built over a window of the
     image holds the stack there alone: its (rows, cols) start at level pixel ``origin`` (x,
-    y) of the level's whole ``size`` (H, W), and ``widen`` builds it over the whole level
-    when a read falls outside (reading the frame again)."""
+    y) of the level's whole ``size`` (H, W), and ``whole`` makes it over the whole level
+    when a read falls outside (``holding``; reading the frame again)."""
 
     stack: np.ndarray
     scale: float  # full-resolution pixels per level pixel
@@ -234,7 +232,7 @@ class Level:
 
     def holding(self, x: np.ndarray, y: np.ndarray, reach: int) -> Level:
         """This level, widened to the whole level first if the stack lacks a pixel within
-        ``reach`` (0 or 1) pixels right of and below level pixels (x, y) (floats or ints)
+        ``reach`` (0-2) pixels right of and below level pixels (x, y) (floats or ints)
         that lie in the level; the edges of the level itself are the stack's own."""
         if self.whole is None or not len(x):
             return self

@@ -284,16 +284,22 @@ class Tracker(FrameFit):
         as a full-resolution box (x0, y0, x1, y1); None for a view whose camera moves, or
         where the image is small (``WINDOW_FROM``) or the box covers most of it
         (``WHOLE_SHARE``)."""
+        sizes = [self.seq.grey(c, frame).shape for c in range(len(pose.views))]
+        windowed = [self.moving[c] is None and H * W >= WINDOW_FROM
+                    for c, (H, W) in enumerate(sizes)]
+        if not any(windowed):  # small footage (the common case): no pose to work out
+            return [None] * len(pose.views)
         kin = Kinematics(self.skeleton, pose)
         out: list[tuple | None] = []
-        for c, view in enumerate(pose.views):
-            H, W = self.seq.grey(c, frame).shape
+        for view, (H, W), on in zip(pose.views, sizes, windowed):
+            if not on:
+                out.append(None)
+                continue
             boxes = raycast.blob_boxes(view, self._blobs, kin.segments)
             lo, hi = boxes[:, :2].min(0), boxes[:, 2:].max(0)
             reach = READ_REACH * float(np.max(hi - lo))
             (x0, y0), (x1, y1) = np.maximum(lo - reach, 0), np.minimum(hi + reach, (W, H))
-            if self.moving[c] is not None or W * H < WINDOW_FROM or \
-                    not np.all(np.isfinite([x0, y0, x1, y1])) or x1 <= x0 or y1 <= y0 or \
+            if not np.all(np.isfinite([x0, y0, x1, y1])) or x1 <= x0 or y1 <= y0 or \
                     (x1 - x0) * (y1 - y0) > WHOLE_SHARE * W * H:
                 out.append(None)
             else:
