@@ -1,6 +1,6 @@
 """Two suite runs side by side: which clip-looks a change moved beyond their starts' spread.
 
-    python bench/compare.py BEFORE AFTER [--runs "3 views 15 fps,..."]
+    python bench/compare.py BEFORE AFTER [--runs "3 views 15 fps,..."] [--twins TWIN ...]
 
 BEFORE and AFTER are what ``bench/suite.py`` printed (its log) or wrote (``--write``): the
 per-clip table's rows are read wherever they stand in the file, every other line is passed
@@ -13,6 +13,13 @@ Tracking is chaotic, so a clip-look moved only where each file's mean over its s
 frames lies outside the other's lowest-highest range: a difference inside the spread of a
 few starts is no difference. A file tracked from one start has no spread, and every
 difference in it reads as a move.
+
+Three starts understate the chaos: the same code with one default setting nudged in its
+seventh digit (``bench/suite.py --settings '{"damping": 0.010000001}'``), or every pixel's
+weight changed by a part in 10^12, moves the worst clip-looks by several degrees beyond their
+starts' spread. TWIN files are such runs of BEFORE's code: BEFORE and its twins are pooled
+(``pooled``), its mean over theirs and its range from their lowest to their highest, so that
+a clip-look moves only beyond what a change of nothing moves it by.
 """
 
 from __future__ import annotations
@@ -66,6 +73,13 @@ def read_flags(text: str) -> dict[str, tuple[int, int]]:
     return out
 
 
+def pooled(rows: list[Row]) -> Row:
+    """Runs of one code (a file and its twins) as one: the mean of their means, their
+    lowest and highest starts, the held-still and best-fit references of the first."""
+    return Row(statistics.fmean(r.tracker for r in rows), min(r.low for r in rows),
+               max(r.high for r in rows), rows[0].still, rows[0].best)
+
+
 def moved(before: Row, after: Row) -> int:
     """+1 where ``after`` is worse beyond both runs' spreads, -1 better, 0 neither."""
     if after.tracker > before.high and before.tracker < after.low:
@@ -82,10 +96,15 @@ def _summary(rows: list[Row]) -> str:
             f" ({statistics.median(over):+.1f} / {max(over):+.1f} over best fit)")
 
 
-def compare(before_text: str, after_text: str, runs: list[str] | None = None) -> list[str]:
+def compare(before_text: str, after_text: str, runs: list[str] | None = None,
+            twins: list[str] = ()) -> list[str]:
     """The comparison's lines: per run, the summaries before -> after over the clip-looks
-    both hold, the flags, and each clip-look that moved (``moved``)."""
+    both hold, the flags, and each clip-look that moved (``moved``); ``twins``: texts of
+    runs of the before's code with nothing changed but chaos, pooled with it where they
+    hold the clip-look (``pooled``)."""
     before, after = read_rows(before_text), read_rows(after_text)
+    twin_rows = [read_rows(t) for t in twins]
+    before = {k: pooled([r, *(t[k] for t in twin_rows if k in t)]) for k, r in before.items()}
     flags_before, flags_after = read_flags(before_text), read_flags(after_text)
     common = [k for k in before if k in after]
     lines = []
@@ -117,9 +136,12 @@ def main(argv=None) -> int:
     ap.add_argument("before", type=Path, help="a suite log or results file")
     ap.add_argument("after", type=Path, help="another, of the change")
     ap.add_argument("--runs", help="comma-separated run names (default: every run in both)")
+    ap.add_argument("--twins", type=Path, nargs="*", default=[],
+                    help="runs of BEFORE's code with a setting nudged in its seventh digit")
     a = ap.parse_args(argv)
     runs = a.runs.split(",") if a.runs else None
-    print("\n".join(compare(a.before.read_text(), a.after.read_text(), runs)))
+    print("\n".join(compare(a.before.read_text(), a.after.read_text(), runs,
+                            [t.read_text() for t in a.twins])))
     return 0
 
 

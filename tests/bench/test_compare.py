@@ -1,5 +1,5 @@
 """Two suite tables compared: rows read back as the suite writes them, and a clip-look
-counted as moved only beyond both runs' spreads."""
+counted as moved only beyond both runs' spreads, the first's widened by its twins'."""
 
 import statistics
 import sys
@@ -8,7 +8,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "bench"))
 
-from compare import Row, compare, moved, read_flags, read_rows  # noqa: E402
+from compare import Row, compare, moved, pooled, read_flags, read_rows  # noqa: E402
 from suite import table  # noqa: E402
 
 RUN = "3 views 15 fps"
@@ -69,3 +69,26 @@ def test_the_comparison_names_what_moved_and_summarises_the_common_clip_looks():
 def test_a_run_without_change_says_so():
     lines = compare(_text(BEFORE), _text(BEFORE))
     assert lines[-1] == "  no clip-look moved beyond its spread"
+
+
+def test_twins_pool_with_the_first_run():
+    a, b = Row(20.0, 18.0, 23.0, 30, 2.5), Row(28.0, 25.0, 32.0, 31, 2.4)
+    both = pooled([a, b])
+    assert both == Row(24.0, 18.0, 32.0, 30, 2.5)
+    assert pooled([a]) == a
+
+
+def test_a_move_inside_what_a_twin_moved_is_no_move():
+    # the dance read 28 when nothing but chaos changed: a change reading 30 has not moved it
+    after = dict(BEFORE)
+    after["dance", "sun", RUN] = _row(30.0, 28.0, 31.0, best=2.5, flags=(30, 40, 100))
+    twin = dict(BEFORE)
+    twin["dance", "sun", RUN] = _row(28.0, 25.0, 32.0, best=2.5, flags=(30, 40, 100))
+    lines = compare(_text(BEFORE), _text(after), twins=[_text(twin)])
+    assert lines[-1] == "  no clip-look moved beyond its spread"
+    # the before side's summary is the pooled one: the dance's mean of 20 and 28
+    assert "/ 24.0 (" in lines[0].split("->")[0]
+    # a twin that stayed put leaves the verdict as it was
+    lines = compare(_text(BEFORE), _text(after), twins=[_text(BEFORE)])
+    assert [ln for ln in lines if "worse" in ln] == [
+        "  worse: dance, sun: 20.0 (18.0-23.0) -> 30.0 (28.0-31.0)"]
