@@ -28,6 +28,7 @@ import argparse
 import re
 import statistics
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -97,7 +98,7 @@ def _summary(rows: list[Row]) -> str:
 
 
 def compare(before_text: str, after_text: str, runs: list[str] | None = None,
-            twins: list[str] = ()) -> list[str]:
+            twins: Sequence[str] = ()) -> list[str]:
     """The comparison's lines: per run, the summaries before -> after over the clip-looks
     both hold, the flags, and each clip-look that moved (``moved``); ``twins``: texts of
     runs of the before's code with nothing changed but chaos, pooled with it where they
