@@ -21,8 +21,9 @@ by more than DEG degrees in one frame, each with what moved it there: the limb s
 it hangs from, or the solver's steps alone. With ``--one-step``, every frame tracked once
 more, alone, from the best fit of the frames before (``walk_benchmark.one_step_poses``;
 ``at-truth``: predicted at the frame's own best fit), its root's heading against the best
-fit's, and the share of each frame's turn it leaves undone: a bias of the cost itself, apart
-from drift (``docs/RESEARCH.md``, fifty-seventh session). ``--start`` is the frame the run
+fit's, the share of each frame's turn it leaves undone, and each limb's mean error against
+the best fit after that one step: a bias of the cost itself, apart from drift
+(``docs/RESEARCH.md``, fifty-seventh and sixty-second sessions). ``--start`` is the frame the run
 started from (``__from_N`` in the job's name).
 """
 
@@ -176,6 +177,8 @@ def main(argv=None) -> int:
         print(f"  each frame's turn left undone: {lag_share(beyond, turn):.2f}; "
               "the eight limbs against the best fit: "
               f"{np.mean([per[label][1:].mean() for label, _, _ in limbs]):.2f} degrees")
+        print("  each limb against the best fit: " + ", ".join(
+            f"{label} {per[label][1:].mean():.1f}" for label, _, _ in limbs))
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")
