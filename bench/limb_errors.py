@@ -23,8 +23,8 @@ more, alone, from the best fit of the frames before (``walk_benchmark.one_step_p
 ``at-truth``: predicted at the frame's own best fit), its root's heading against the best
 fit's, the share of each frame's turn it leaves undone, and each limb's mean error against
 the best fit after that one step: a bias of the cost itself, apart from drift
-(``docs/RESEARCH.md``, fifty-seventh and sixty-second sessions). ``--start`` is the frame the run
-started from (``__from_N`` in the job's name).
+(``docs/RESEARCH.md``, fifty-seventh and sixty-second sessions). ``--start`` is the frame
+the run started from (``__from_N`` in the job's name).
 """
 
 from __future__ import annotations
@@ -174,11 +174,12 @@ def main(argv=None) -> int:
         print(f"one step from the best fit ({args.one_step}): per frame, the root's heading "
               "beyond the best fit's / the best fit's turn since the frame before, degrees")
         print("  ".join(f"{a:+.1f}/{b:+.1f}" for a, b in zip(beyond, turn)))
+        means = {label: per[label][1:].mean() for label, _, _ in limbs}
         print(f"  each frame's turn left undone: {lag_share(beyond, turn):.2f}; "
               "the eight limbs against the best fit: "
-              f"{np.mean([per[label][1:].mean() for label, _, _ in limbs]):.2f} degrees")
+              f"{np.mean(list(means.values())):.2f} degrees")
         print("  each limb against the best fit: " + ", ".join(
-            f"{label} {per[label][1:].mean():.1f}" for label, _, _ in limbs))
+            f"{label} {mean:.1f}" for label, mean in means.items()))
     for joint in filter(None, args.twist.split(",")):
         rows = twist_rows(job, est, best, joint)
         print(f"{joint} against the best fit, per frame: swing / twist, degrees")
