@@ -276,7 +276,7 @@ def _stack(cur: np.ndarray, blur: float, highpass: float) -> np.ndarray:
         sm = sm - cv2.GaussianBlur(sm, (0, 0), highpass)
     gx = cv2.Sobel(sm, cv2.CV_32F, 1, 0, ksize=3, scale=1 / 8)
     gy = cv2.Sobel(sm, cv2.CV_32F, 0, 1, ksize=3, scale=1 / 8)
-    # OpenCV's merge: numpy's dstack took 7 times as long on colour, holding the GIL
+    # OpenCV's merge: numpy's dstack took 7 times as long on a colour level
     return cv2.merge([sm, gx, gy])
 
 
