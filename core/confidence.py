@@ -17,20 +17,26 @@ body part reads as agreeing there (its bone is on the silhouette, its pixels fol
 covers), so one frame's fair agreement does not show that a limb in doubt is found again. A
 limb over another body part in every view from the start reads as agreeing: nothing tells.
 
-The flags the report and the add-on show are the tracker's doubts, except with one view.
-There no second view can disagree, and a limb turned toward or away from the camera, which
-one view shows only as foreshortening, reads as agreeing wherever its outline lands. What
-the view does show is the limb's own pixels where the track left them: foreground that no
-blob explains, beside the limb (``Limbs.unexplained``: within ``UNEXPLAINED_REACH`` of its
-length from its joint, past ``UNEXPLAINED_GAP`` of the blobs' outline, in units of the
-limb's own outline's area). So with one view the flag reads, at the tracker's own bars, the
-confidence divided by one plus ``UNEXPLAINED_WEIGHT`` times that
-(``LimbCheck.flag_confidence``), each from its own frame before; a view with no backdrop
-(a camera that moves, the silhouette off) cannot tell it, and its flag reads the confidence
-under the higher bars of ``ONE_VIEW_FLAG``, which the flags had before. Hands, feet and hair
-have no blob and add a little near the forearms, shanks and neck on every frame alike. The
-tracker's own doubt reads the plain confidence there too: it holds a doubted limb where it
-was, which costs more than a look.
+The flags the report and the add-on show read a limb's own bone: a forearm's or a shank's
+agreement leaves out the hand or the foot that hangs from it (``Limbs.own_blob``), which
+turns at a wrist or an ankle the tracker holds, so that its misfit says nothing of the
+limb's direction. The tracker's own doubt, which holds a limb and lets go of its pixels,
+reads everything the limb moves: a foot's disagreeing pixels are no template either. Each
+flag reads its own state on the frame before.
+
+With one view no second view can disagree, and a limb turned toward or away from the
+camera, which one view shows only as foreshortening, reads as agreeing wherever its outline
+lands. What the view does show is the limb's own pixels where the track left them:
+foreground that no blob explains, beside the limb (``Limbs.unexplained``: within
+``UNEXPLAINED_REACH`` of its length from its joint, past ``UNEXPLAINED_GAP`` of the blobs'
+outline, in units of the limb's own outline's area). So with one view the flag reads, at
+the tracker's own bars, the confidence divided by one plus ``UNEXPLAINED_WEIGHT`` times that
+(``LimbCheck.flag_confidence``); a view with no backdrop (a camera that moves, the
+silhouette off) cannot tell it, and its flag reads the confidence under the higher bars of
+``ONE_VIEW_FLAG``, which the flags had before. Hands, feet and hair that have no blob add a
+little near the forearms, shanks and neck on every frame alike. The tracker's own doubt
+reads the plain confidence there too: it holds a doubted limb where it was, which costs
+more than a look.
 """
 
 from __future__ import annotations
@@ -64,14 +70,24 @@ class LimbCheck:
     """One limb on one frame: its confidence in [0, 1], per view its agreement in [0, 1]
     (None where the view does not see it), whether the tracker doubted it on the frame
     before (``doubted``) and the report flagged it there (``was_flagged``; None: the same),
-    and with one view the foreground no blob explains near it (``Limbs.unexplained``; None
-    where the view has no backdrop to tell it, and with more views)."""
+    with one view the foreground no blob explains near it (``Limbs.unexplained``; None
+    where the view has no backdrop to tell it, and with more views), and per view the
+    agreement of the limb's own bone (``own_views``: ``Limbs.view_agreement``'s ``own``;
+    None: as ``views``)."""
 
     confidence: float
     views: tuple[float | None, ...]
     doubted: bool = False
     was_flagged: bool | None = None
     unexplained: float | None = None
+    own_views: tuple[float | None, ...] | None = None
+
+    @property
+    def own_confidence(self) -> float:
+        """The confidence the flags read: the worst agreement of the limb's own bone among
+        the views that see it (the confidence itself where no view sees that bone alone)."""
+        seen = [v for v in self.own_views or () if v is not None]
+        return min(seen) if seen else self.confidence
 
     @property
     def doubt(self) -> str:
@@ -81,21 +97,21 @@ class LimbCheck:
     @property
     def flag(self) -> str:
         """What the report and the add-on show: '' when the limb can be trusted, else
-        ``unseen`` or ``unsure`` (the tracker's doubt, but with one view the reading of
-        ``flag_confidence``, or without a backdrop the confidence at ``ONE_VIEW_FLAG``)."""
-        if len(self.views) > 1:
-            return self.doubt
+        ``unseen`` or ``unsure``: ``own_confidence`` at the tracker's bars, but with one view
+        ``flag_confidence``, or without a backdrop ``own_confidence`` at ``ONE_VIEW_FLAG``."""
         before = self.doubted if self.was_flagged is None else self.was_flagged
+        if len(self.views) > 1:
+            return self._reading(before, self.own_confidence)
         if self.unexplained is None:
-            return self._reading(before, self.confidence, *ONE_VIEW_FLAG)
+            return self._reading(before, self.own_confidence, *ONE_VIEW_FLAG)
         return self._reading(before, self.flag_confidence)
 
     @property
     def flag_confidence(self) -> float:
-        """The confidence the one-view flag reads: divided by one plus ``UNEXPLAINED_WEIGHT``
-        times the foreground no blob explains near the limb, in units of its own outline's
-        area (the confidence itself where that is not known)."""
-        return discounted(self.confidence, self.unexplained)
+        """The confidence the one-view flag reads: ``own_confidence`` divided by one plus
+        ``UNEXPLAINED_WEIGHT`` times the foreground no blob explains near the limb, in units
+        of its own outline's area (``own_confidence`` itself where that is not known)."""
+        return discounted(self.own_confidence, self.unexplained)
 
     def _reading(self, before: bool, confidence: float, enter: float = DOUBT,
                  leave: float = CLEAR) -> str:
@@ -157,6 +173,11 @@ class Limbs:
         self.joint_ref = skeleton.rest_positions[self.joint].reshape(-1, 3)
         index = {j: i for i, j in enumerate(joints)}
         self.of_blob = np.array([index.get(int(j), -1) for j in owner], dtype=int)
+        # the same without the segments that hang from a hinge's own (a hand, a foot), which
+        # turn at joints the tracker holds: what the flags read (``LimbCheck.own_confidence``)
+        below_hinge = np.array([o >= 0 and skeleton.kinds[o] == HINGE and m != o
+                                for m, o in zip(blob_joint, owner)], dtype=bool)
+        self.own_blob = np.where(below_hinge, -1, self.of_blob)
         # points along each limb blob's longest axis, in its segment's frame: where the
         # bone runs whatever the blob's girth
         t = np.linspace(-AXIS_REACH, AXIS_REACH, AXIS_POINTS)
@@ -166,6 +187,7 @@ class Limbs:
         self.axis_joint = np.repeat(blob_joint[mine], len(t))
         self.axis_ref = (blobs.centre[mine, None] + axis[:, None] * t[:, None]).reshape(-1, 3)
         self.axis_limb = np.repeat(self.of_blob[mine], len(t))
+        self.axis_own = np.repeat(self.own_blob[mine], len(t))
         # each point's blob's thickness: twice the mean of its two shorter radii, world units
         self.axis_thickness = np.repeat(2 * np.sort(blobs.radii[mine], axis=1)[:, :2].mean(1),
                                         len(t))
@@ -174,22 +196,24 @@ class Limbs:
         return len(self.names)
 
     def view_agreement(self, point_blob: np.ndarray, support: np.ndarray,
-                       axis_on: np.ndarray | None = None) -> np.ndarray:
+                       axis_on: np.ndarray | None = None, own: bool = False) -> np.ndarray:
         """One view's agreement per limb (L,), NaN where the view does not see the limb.
         ``point_blob`` (N,): each mapped pixel's blob; ``support`` (N,): its support in
         [0, 1], NaN where it is hidden or off the image. ``axis_on``: per point of
         ``axis_ref`` at the frame's pose, 1 where the view's foreground holds it, 0 where
-        not, NaN off the image; None without a still backdrop."""
+        not, NaN off the image; None without a still backdrop. ``own``: read on each limb's
+        own bone alone (``own_blob``), not the hand or foot hanging from a hinge's."""
         L = len(self)
-        limb = self.of_blob[point_blob]
+        limb = (self.own_blob if own else self.of_blob)[point_blob]
         use = (limb >= 0) & ~np.isnan(support)
         count = np.bincount(limb[use], minlength=L)
         total = np.bincount(limb[use], weights=support[use], minlength=L)
         agree = np.where(count >= MIN_LIMB_POINTS, total / np.maximum(count, 1), np.nan)
         if axis_on is not None:
-            use = ~np.isnan(axis_on)
-            area = np.bincount(self.axis_limb[use], minlength=L)
-            hit = np.bincount(self.axis_limb[use], weights=axis_on[use], minlength=L)
+            axis_limb = self.axis_own if own else self.axis_limb
+            use = ~np.isnan(axis_on) & (axis_limb >= 0)
+            area = np.bincount(axis_limb[use], minlength=L)
+            hit = np.bincount(axis_limb[use], weights=axis_on[use], minlength=L)
             agree *= np.where(area > 0, hit / np.maximum(area, 1), 1.0)
         return agree
 
@@ -249,18 +273,22 @@ class Limbs:
         return out
 
     def checks(self, per_view: Sequence[np.ndarray], doubted: Collection[str] = (),
-               flagged: Collection[str] | None = None, unexplained: np.ndarray | None = None
-               ) -> dict[str, LimbCheck]:
+               flagged: Collection[str] | None = None, unexplained: np.ndarray | None = None,
+               own_views: Sequence[np.ndarray] | None = None) -> dict[str, LimbCheck]:
         """Each limb's check from its agreement in every view (``view_agreement``'s);
         ``doubted`` and ``flagged``: the limbs the tracker doubted and the report flagged
         on the frame before (None: those doubted); ``unexplained``: one view's
         ``unexplained`` (None: not known)."""
+        def at(agreements, i):
+            return tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
+                         for a in agreements)
+
         out = {}
         for i, name in enumerate(self.names):
-            views = tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
-                          for a in per_view)
+            views = at(per_view, i)
             seen = [v for v in views if v is not None]
             out[name] = LimbCheck(min(seen) if seen else 0.0, views, name in doubted,
                                   None if flagged is None else name in flagged,
-                                  None if unexplained is None else float(unexplained[i]))
+                                  None if unexplained is None else float(unexplained[i]),
+                                  None if own_views is None else at(own_views, i))
         return out

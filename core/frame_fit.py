@@ -735,7 +735,7 @@ class FrameFit:
         it; ``doubted`` and ``flagged``: the limbs doubted and flagged on the frame before."""
         top = 1 + self.settings.outlier_density
         axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
-        per_view = []
+        per_view, own_views = [], []
         for c, (ps, sigma, (ok, _, _, r)) in enumerate(zip(sets, smp.sigmas, smp.parts)):
             support = np.full(len(ps.value), np.nan)
             support[ok] = np.minimum(
@@ -752,9 +752,10 @@ class FrameFit:
                 code = crop[px[inside, 1], px[inside, 0]]
                 on[inside] = np.where(code == sil.UNSURE, np.nan, code == sil.FOREGROUND)
             per_view.append(self._limbs.view_agreement(ps.blob, support, on))
+            own_views.append(self._limbs.view_agreement(ps.blob, support, on, own=True))
         return self._limbs.checks(per_view, doubted, flagged,
                                   self._unexplained(kin, smp, fgs) if self.seq.n_views == 1
-                                  else None)
+                                  else None, own_views)
 
     def _unexplained(self, kin: Kinematics, smp: _Samples, fgs: list | None
                      ) -> np.ndarray | None:

@@ -75,9 +75,9 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
                 "given": f.given,
                 "turned": None if f.turned is None else round(f.turned, 1),
                 "searched": list(f.searched),
-                "limbs": {name: {"confidence": round(c.confidence, 3), "flag": c.flag,
+                "limbs": {name: {"confidence": round(c.own_confidence, 3), "flag": c.flag,
                                  "views": [None if v is None else round(v, 3)
-                                           for v in c.views],
+                                           for v in c.own_views or c.views],
                                  "unexplained": None if c.unexplained is None
                                  else round(c.unexplained, 3)}
                           for name, c in f.limbs.items()},

@@ -28,7 +28,7 @@ from core.linearize import Kinematics
 from core.pose import CALIBRATED, BodyPose
 from core.raycast import BlobStack
 from core.settings import TrackerSettings
-from core.skeleton import human_template
+from core.skeleton import BALL, FIXED, HINGE, Skeleton, human_template
 from core.tracker import Tracker, doubts_begun, frames_to_check, track
 from support.synthetic import render, side_view
 
@@ -56,6 +56,69 @@ def test_a_blob_belongs_to_the_deepest_tracked_joint_that_moves_it(template):
             name = limbs.names[limbs.of_blob[b]]
             assert name == above[0]  # ancestors run from the blob's joint up
             assert moved[blob.joint, sk.index(name)]
+
+
+def _arm_with_hand_and_head() -> Skeleton:
+    """Metres, y up: a ball shoulder with a hinge elbow and a hand fixed on the forearm, and
+    a ball neck with a head fixed on it."""
+    names = ["Hips", "Shoulder", "Elbow", "Hand", "Neck", "Head"]
+    sk = Skeleton(names=names, parents=[-1, 0, 1, 2, 0, 4],
+                  offsets=[(0, 1, 0), (0.2, 0.4, 0), (0, -0.3, 0), (0, -0.27, 0), (0, 0.5, 0),
+                           (0, 0.1, 0)],
+                  kinds=[FIXED, BALL, HINGE, FIXED, BALL, FIXED],
+                  end_sites=[[], [], [], [np.array([0, -0.12, 0])], [],
+                             [np.array([0, 0.22, 0])]])
+    sk.blobs = sk.default_blobs()
+    return sk
+
+
+def test_a_limbs_own_bone_leaves_out_what_hangs_from_a_hinges_segment_alone():
+    """The forearm's limb moves the hand too, but its own bone is the forearm alone (the
+    hand turns at a wrist the tracker holds); a ball's fixed child (the head on the neck)
+    stays its limb's own."""
+    sk = _arm_with_hand_and_head()
+    limbs = _limbs(sk)
+    stack = BlobStack.of(sk.blobs)
+    name_of = {b: sk.names[j] for b, j in enumerate(stack.joint)}
+    for b, segment in name_of.items():
+        limb = limbs.of_blob[b]
+        expected = {"Shoulder": "Shoulder", "Elbow": "Elbow", "Hand": "Elbow",
+                    "Neck": "Neck", "Head": "Neck"}.get(segment)
+        assert (limbs.names[limb] if limb >= 0 else None) == expected, segment
+        own = limbs.own_blob[b]
+        assert own == (-1 if segment == "Hand" else limb), segment
+    assert "Hand" in name_of.values()
+    assert np.array_equal(limbs.axis_own == -1, limbs.axis_joint == sk.index("Hand"))
+
+
+def test_own_agreement_is_each_limbs_own_bones_mean_support_times_their_share_on_it():
+    """Against a loop over the pixels and the bone's points: a hand's pixels and bone
+    count for the forearm's agreement, not for its own."""
+    sk = _arm_with_hand_and_head()
+    limbs = _limbs(sk)
+    rng = np.random.default_rng(8)
+    blob = rng.integers(0, len(sk.blobs), 800)
+    support = rng.uniform(0, 1, 800)
+    support[rng.uniform(size=800) < 0.2] = np.nan
+    on = (rng.uniform(size=len(limbs.axis_ref)) < 0.5).astype(float)
+    got = limbs.view_agreement(blob, support, on, own=True)
+    for i in range(len(limbs)):
+        mine = [s for b, s in zip(blob, support) if limbs.own_blob[b] == i and s == s]
+        bone = [x for x, k in zip(on, limbs.axis_own) if k == i]
+        assert got[i] == pytest.approx(np.mean(mine) * np.mean(bone))
+    elbow = limbs.names.index("Elbow")
+    assert got[elbow] != pytest.approx(limbs.view_agreement(blob, support, on)[elbow])
+
+
+def test_the_flag_reads_a_limbs_own_bone_and_the_doubt_all_it_moves():
+    """A forearm whose hand disagrees: the tracker doubts it, the flag does not; where no
+    view sees its own bone alone, the flag reads the plain confidence."""
+    check = LimbCheck(0.2, (0.2, 0.9), own_views=(0.8, 0.9))
+    assert check.own_confidence == pytest.approx(0.8)
+    assert check.doubt == UNSURE_FLAG and check.flag == ""
+    assert LimbCheck(0.8, (0.8, 0.9), own_views=(0.3, None)).flag == UNSURE_FLAG
+    hidden = LimbCheck(0.2, (0.2, 0.9), own_views=(None, None))
+    assert hidden.own_confidence == pytest.approx(0.2) and hidden.flag == UNSURE_FLAG
 
 
 def test_view_agreement_is_each_seen_limbs_mean_support_times_its_bone_on_the_silhouette(
@@ -208,7 +271,7 @@ def test_one_view_flags_what_its_unexplained_foreground_discounts_the_tracker_do
     """With one view the report's flag reads the confidence over one plus
     UNEXPLAINED_WEIGHT times the unexplained foreground, at the tracker's bars, from its own
     state on the frame before; the tracker's doubt reads the plain confidence; with two views
-    the two are one whatever the foreground."""
+    the flag reads the plain confidence from its own state, whatever the foreground."""
     read = confidence / (1 + UNEXPLAINED_WEIGHT * unexplained)
     one = LimbCheck(confidence, (confidence,), doubted=False, was_flagged=before,
                     unexplained=unexplained)
@@ -218,8 +281,8 @@ def test_one_view_flags_what_its_unexplained_foreground_discounts_the_tracker_do
     assert LimbCheck(confidence, (confidence,), doubted=before,
                      unexplained=unexplained).flag == one.flag  # None: as doubted
     two = LimbCheck(confidence, (confidence, 0.99), doubted=before, was_flagged=False,
-                    unexplained=unexplained)
-    assert two.flag == two.doubt
+                    unexplained=unexplained)  # its own frame before, no foreground counted
+    assert two.flag == (UNSURE_FLAG if confidence < DOUBT else "")
     assert LimbCheck(0.0, (None,), was_flagged=before, unexplained=unexplained).flag == UNSEEN
 
 
@@ -343,6 +406,31 @@ def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
     assert {n for n, c in res.frames[2].limbs.items() if c.doubted} == {
         n for n, c in checks.items() if c.flag}
     assert res.frames[2].limbs[gone].flag == UNSURE_FLAG
+
+
+def test_a_hand_turned_at_its_held_wrist_is_doubted_by_the_tracker_not_flagged():
+    """Three views of an arm whose hand turns 70 degrees at the wrist from the second frame
+    on, tracked by the real tracker with the wrist held: the forearm stays where it is, its
+    hand's pixels and bone disagree, so the tracker doubts the limb (it lets go of them),
+    while its own bone agrees and the report does not flag it."""
+    sk = _arm_with_hand_and_head()
+    views = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
+    still = np.tile(np.eye(3), (sk.n_joints, 1, 1))
+    pose = BodyPose(still, sk.rest_positions[0].copy(), views)
+    bent = still.copy()
+    bent[sk.index("Hand")] = se3.exp_so3(np.array([np.radians(70), 0, 0]))
+    moved = BodyPose(bent, pose.root_position, views)
+    frames = [[render(sk, pose if k == 0 else moved, c, noise=0.01, seed=10 * k + c)
+               for k in range(3)] for c in range(3)]
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
+                [0, 1, 2])
+    for fr in res.frames[1:]:
+        elbow = fr.pose.rotations[sk.index("Elbow")]
+        assert np.degrees(se3.rotation_angle_between(elbow, np.eye(3))) < 2
+        arm = fr.limbs["Elbow"]
+        assert arm.doubt == UNSURE_FLAG and arm.flag == "", arm
+        assert arm.own_confidence > arm.confidence + 0.2
+        assert "Elbow" not in fr.flagged
 
 
 @pytest.mark.parametrize("frames, text", [
