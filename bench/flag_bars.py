@@ -1,21 +1,21 @@
-"""One view's flag bars read again over the suite's reports: what a pair of bars would catch.
+"""The flags' bars read again over the suite's reports: what a pair of bars would catch.
 
-    python bench/flag_bars.py [--runs "1 lateral view 15 fps,..."] [--clips NAME,...]
-                              [--enter 0.35,0.45,...] [--clear 0.9,0.95,0.99]
-                              [--weight W]
+    python bench/flag_bars.py [--runs "1 lateral view 15 fps,3 views 15 fps,..."]
+                              [--clips NAME,...] [--enter 0.35,0.45,...]
+                              [--clear 0.9,0.95,0.99] [--weight W]
 
-The flags do not steer the tracker with one view (``core.confidence``): the report's
-confidences are what the flags are read from, so the suite's one-view runs need not be
-tracked again to see other bars. For every report ``bench/suite.py`` left in ``.cache/suite``
-for the runs (every clip, look and start, or the ``--clips`` named), each one-view limb's flag
-is read again at each pair of bars from its confidence over one plus ``--weight`` times its
-unexplained foreground (``LimbCheck.flag_confidence``; ``confidence.reading``, each limb's
-flag on the frame before carried on), and scored as the suite scores flags
-(``suite.flag_counts``): % of the limbs over ``suite.BAD_LIMB_DEG`` off that are flagged / %
-of the flags on such limbs. The reports keep confidences to three places, so a count can
-differ from the suite's by the few limb-frames that lie on a bar.
-``core.confidence.UNEXPLAINED_WEIGHT`` was chosen this way on the CMU clips, at the tracker's
-own bars (``docs/RESEARCH.md``).
+The flags do not steer the tracker (``core.confidence``: the tracker's doubt reads its own
+confidence, at its own bars): the report's confidences are what the flags are read from, so
+the suite's runs need not be tracked again to see other bars. For every report
+``bench/suite.py`` left in ``.cache/suite`` for the runs with the default settings (every
+clip, look and start, or the ``--clips`` named), each limb's flag is read again at each pair
+of bars from its confidence, with one view over one plus ``--weight`` times its unexplained
+foreground (``LimbCheck.flag_confidence``; ``confidence.reading``, each limb's flag on the
+frame before carried on), and scored as the suite scores flags (``suite.flag_counts``): % of
+the limbs over ``suite.BAD_LIMB_DEG`` off that are flagged / % of the flags on such limbs.
+The reports keep confidences to three places, so a count can differ from the suite's by the
+few limb-frames that lie on a bar. ``core.confidence.UNEXPLAINED_WEIGHT`` and the flags' bars
+were chosen this way (``docs/RESEARCH.md``).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import copy
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -30,17 +31,17 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from suite import CACHE, RUNS, flag_counts, slug, tracked_and_true  # noqa: E402
+from suite import CACHE, flag_counts, slug, tracked_and_true  # noqa: E402
 
 from core.confidence import CLEAR, DOUBT, UNEXPLAINED_WEIGHT, discounted, reading  # noqa: E402
 
 
 def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED_WEIGHT
               ) -> dict:
-    """A copy of a one-view report (``python -m core track --report``) with every limb's flag
-    read at bars ``enter`` and ``clear`` (from its confidence over one plus its unexplained
-    foreground, ``LimbCheck.flag_confidence``), frame after frame in order; a frame without
-    checks (one the user gave) starts every limb afresh."""
+    """A copy of a report (``python -m core track --report``) with every limb's flag read at
+    bars ``enter`` and ``clear`` (from its confidence, with one view over one plus its
+    unexplained foreground, ``LimbCheck.flag_confidence``), frame after frame in order; a
+    frame without checks (one the user gave) starts every limb afresh."""
     out = copy.deepcopy(rep)
     before: dict[str, bool] = {}
     for fr in out["frames"]:
@@ -55,13 +56,17 @@ def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED
 
 
 def run_reports(run: str, clips: list[str] | None = None) -> list[tuple[Path, int]]:
-    """The tracked jobs of ``run`` in the suite's cache (every start), as (job, start)."""
+    """The jobs of ``run`` the suite's cache holds tracked with the default settings (every
+    start; not those of ``--settings``, whose names carry them), as (job, start)."""
     out = []
     for rep in sorted(CACHE.glob(f"*/*__{slug(run)}*.report.json")):
         job = rep.with_name(rep.name.replace(".report.json", ".json"))
+        tail = job.stem.split(f"__{slug(run)}", 1)[1]
+        if tail and not re.fullmatch(r"__from_\d+", tail):
+            continue
         if clips is not None and job.parent.name not in {slug(c) for c in clips}:
             continue
-        start = int(job.stem.split("__from_")[1]) if "__from_" in job.stem else 0
+        start = int(tail[len("__from_"):]) if tail else 0
         out.append((job, start))
     return out
 
@@ -97,7 +102,7 @@ def bar_table(run: str, jobs: list[tuple[Path, int]], enters: list[float],
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", default="1 lateral view 15 fps,1 lateral view 30 fps",
-                    help="comma-separated one-view run names")
+                    help="comma-separated run names")
     ap.add_argument("--clips", help="comma-separated clip names (default: every one tracked)")
     ap.add_argument("--enter", default="0.35,0.45,0.5,0.55,0.6,0.65")
     ap.add_argument("--clear", default="0.9,0.95,0.99")
@@ -107,8 +112,6 @@ def main(argv=None) -> int:
     enters = [float(x) for x in a.enter.split(",")]
     clears = [float(x) for x in a.clear.split(",")]
     for run in a.runs.split(","):
-        if len(RUNS[run][0]) != 1:
-            raise SystemExit(f"{run}: not a one-view run; three views flag as they doubt")
         jobs = run_reports(run, a.clips.split(",") if a.clips else None)
         if not jobs:
             raise SystemExit(f"{run}: no tracked reports in {CACHE} (run bench/suite.py)")

@@ -1,5 +1,6 @@
-"""One view's flags read again from a report: the tracker's own flags given back at the bars
-in use, and each limb's flag carried from frame to frame as the tracker carries it."""
+"""Flags read again from a report: the tracker's own flags given back at the bars in use,
+each limb's flag carried from frame to frame as the tracker carries it, and the suite's
+reports of the default settings alone."""
 
 import copy
 import sys
@@ -24,7 +25,8 @@ from flag_bars import reflagged  # noqa: E402
 def _report(frames) -> dict:
     """The report's frames (``core.run.report``'s ``frames``) of tracked results, its
     confidences unrounded."""
-    return {"frames": [{"limbs": {n: {"confidence": c.confidence, "views": list(c.views),
+    return {"frames": [{"limbs": {n: {"confidence": c.own_confidence,
+                                      "views": list(c.own_views or c.views),
                                       "flag": c.flag, "unexplained": c.unexplained}
                                   for n, c in fr.limbs.items()}}
                        for fr in frames]}
@@ -74,3 +76,22 @@ def test_the_unexplained_foreground_discounts_the_confidence_the_flag_reads():
     for weight, flag in ((0.0, ""), (0.4, ""), (0.5, UNSURE_FLAG), (1.0, UNSURE_FLAG)):
         got = reflagged(rep, 0.35, 0.9, weight)  # 0.5 / (1 + weight) against 0.35
         assert got["frames"][0]["limbs"]["Arm"]["flag"] == flag, weight
+
+
+def test_the_reports_read_are_the_default_settings_of_each_start(tmp_path, monkeypatch):
+    """A run's reports tracked with other settings (their names carry them) or on another
+    run are passed over; each default one is read with the frame it started from."""
+    import flag_bars
+
+    clip = tmp_path / "cmu_131_walk"
+    clip.mkdir()
+    for tail in ("", "__from_1", "__from_2", "__settings_0ba07c8d", "__settings_0ba07c8d__from_1",
+                 "__hand"):
+        (clip / f"muybridge__3_views_15_fps{tail}.report.json").write_text("{}")
+    (clip / "muybridge__3_views_30_fps.report.json").write_text("{}")
+    monkeypatch.setattr(flag_bars, "CACHE", tmp_path)
+    got = flag_bars.run_reports("3 views 15 fps")
+    assert [(job.name, start) for job, start in got] == [
+        ("muybridge__3_views_15_fps.json", 0), ("muybridge__3_views_15_fps__from_1.json", 1),
+        ("muybridge__3_views_15_fps__from_2.json", 2)]
+    assert flag_bars.run_reports("3 views 15 fps", ["CMU 05-01 walk"]) == []
