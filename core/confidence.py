@@ -30,13 +30,13 @@ lands. What the view does show is the limb's own pixels where the track left the
 foreground that no blob explains, beside the limb (``Limbs.unexplained``: within
 ``UNEXPLAINED_REACH`` of its length from its joint, past ``UNEXPLAINED_GAP`` of the blobs'
 outline, in units of the limb's own outline's area). So with one view the flag reads, at
-the tracker's own bars, the confidence divided by one plus ``UNEXPLAINED_WEIGHT`` times that
-(``LimbCheck.flag_confidence``); a view with no backdrop (a camera that moves, the
-silhouette off) cannot tell it, and its flag reads the confidence under the higher bars of
-``ONE_VIEW_FLAG``, which the flags had before. Hands, feet and hair that have no blob add a
-little near the forearms, shanks and neck on every frame alike. The tracker's own doubt
-reads the plain confidence there too: it holds a doubted limb where it was, which costs
-more than a look.
+the tracker's own bars, the own bone's confidence divided by one plus
+``UNEXPLAINED_WEIGHT`` times that (``LimbCheck.flag_confidence``); a view with no backdrop
+(a camera that moves, the silhouette off) cannot tell it, and its flag reads the own bone's
+confidence under the higher bars of ``ONE_VIEW_FLAG``, which the flags had before. Hands,
+feet and hair that have no blob add a little near the forearms, shanks and neck on every
+frame alike. The tracker's own doubt reads the plain confidence there too: it holds a
+doubted limb where it was, which costs more than a look.
 """
 
 from __future__ import annotations
@@ -278,7 +278,8 @@ class Limbs:
         """Each limb's check from its agreement in every view (``view_agreement``'s);
         ``doubted`` and ``flagged``: the limbs the tracker doubted and the report flagged
         on the frame before (None: those doubted); ``unexplained``: one view's
-        ``unexplained`` (None: not known)."""
+        ``unexplained`` (None: not known); ``own_views``: every view's agreement of the
+        limbs' own bones (``view_agreement``'s ``own``; None: not read)."""
         def at(agreements, i):
             return tuple(None if np.isnan(a[i]) else float(np.clip(a[i], 0, 1))
                          for a in agreements)
