@@ -83,10 +83,17 @@ class LimbCheck:
     own_views: tuple[float | None, ...] | None = None
 
     @property
+    def flag_views(self) -> tuple[float | None, ...]:
+        """Per view, the agreement the flags read: ``own_views`` where a view sees the limb's
+        own bone, else ``views`` (no view sees that bone alone, or it was not read)."""
+        own = self.own_views
+        return own if own and any(v is not None for v in own) else self.views
+
+    @property
     def own_confidence(self) -> float:
-        """The confidence the flags read: the worst agreement of the limb's own bone among
-        the views that see it (the confidence itself where no view sees that bone alone)."""
-        seen = [v for v in self.own_views or () if v is not None]
+        """The confidence the flags read: the worst of ``flag_views`` among the views that
+        see the limb (the confidence itself where none does)."""
+        seen = [v for v in self.flag_views if v is not None]
         return min(seen) if seen else self.confidence
 
     @property

@@ -77,7 +77,7 @@ def report(job: Job, result: TrackResult, seconds: float) -> dict:
                 "searched": list(f.searched),
                 "limbs": {name: {"confidence": round(c.own_confidence, 3), "flag": c.flag,
                                  "views": [None if v is None else round(v, 3)
-                                           for v in c.own_views or c.views],
+                                           for v in c.flag_views],
                                  "unexplained": None if c.unexplained is None
                                  else round(c.unexplained, 3)}
                           for name, c in f.limbs.items()},

@@ -26,7 +26,7 @@ def _report(frames) -> dict:
     """The report's frames (``core.run.report``'s ``frames``) of tracked results, its
     confidences unrounded."""
     return {"frames": [{"limbs": {n: {"confidence": c.own_confidence,
-                                      "views": list(c.own_views or c.views),
+                                      "views": list(c.flag_views),
                                       "flag": c.flag, "unexplained": c.unexplained}
                                   for n, c in fr.limbs.items()}}
                        for fr in frames]}

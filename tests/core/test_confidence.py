@@ -119,6 +119,7 @@ def test_the_flag_reads_a_limbs_own_bone_and_the_doubt_all_it_moves():
     assert LimbCheck(0.8, (0.8, 0.9), own_views=(0.3, None)).flag == UNSURE_FLAG
     hidden = LimbCheck(0.2, (0.2, 0.9), own_views=(None, None))
     assert hidden.own_confidence == pytest.approx(0.2) and hidden.flag == UNSURE_FLAG
+    assert hidden.flag_views == (0.2, 0.9) and check.flag_views == (0.8, 0.9)
 
 
 def test_view_agreement_is_each_seen_limbs_mean_support_times_its_bone_on_the_silhouette(
