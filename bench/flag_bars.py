@@ -1,14 +1,15 @@
 """The flags' bars read again over the suite's reports: what a pair of bars would catch.
 
     python bench/flag_bars.py [--runs "1 lateral view 15 fps,3 views 15 fps,..."]
-                              [--clips NAME,...] [--enter 0.35,0.45,...]
-                              [--clear 0.9,0.95,0.99] [--weight W]
+                              [--clips NAME,...] [--half-size] [--exposure-drift]
+                              [--enter 0.35,0.45,...] [--clear 0.9,0.95,0.99] [--weight W]
 
 The flags do not steer the tracker (``core.confidence``: the tracker's doubt reads its own
 confidence, at its own bars): the report's confidences are what the flags are read from, so
 the suite's runs need not be tracked again to see other bars. For every report
 ``bench/suite.py`` left in ``.cache/suite`` for the runs with the default settings (every
-clip, look and start, or the ``--clips`` named), each limb's flag is read again at each pair
+clip, look and start, or the ``--clips`` named; the footage at full size, or halved or its
+exposure drifting, as the suite's ``--half-size`` and ``--exposure-drift``), each limb's flag is read again at each pair
 of bars from its confidence, with one view over one plus ``--weight`` times its unexplained
 foreground (``LimbCheck.flag_confidence``; ``confidence.reading``, each limb's flag on the
 frame before carried on), and scored as the suite scores flags (``suite.flag_counts``): % of
@@ -32,6 +33,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 from suite import CACHE, flag_counts, slug, tracked_and_true  # noqa: E402
+from suite_footage import DRIFT, HALF, LOOKS  # noqa: E402
 
 from core.confidence import CLEAR, DOUBT, UNEXPLAINED_WEIGHT, discounted, reading  # noqa: E402
 
@@ -55,14 +57,18 @@ def reflagged(rep: dict, enter: float, clear: float, weight: float = UNEXPLAINED
     return out
 
 
-def run_reports(run: str, clips: list[str] | None = None) -> list[tuple[Path, int]]:
+def run_reports(run: str, clips: list[str] | None = None, footage: str = ""
+                ) -> list[tuple[Path, int]]:
     """The jobs of ``run`` the suite's cache holds tracked with the default settings (every
-    start; not those of ``--settings``, whose names carry them), as (job, start)."""
+    start; not those of ``--settings``, whose names carry them) on the suite's looks, their
+    names followed by ``footage`` (``""``, ``suite_footage.HALF`` or ``DRIFT``), as
+    (job, start)."""
+    looks = {slug(look) + footage for look in LOOKS}
     out = []
     for rep in sorted(CACHE.glob(f"*/*__{slug(run)}*.report.json")):
         job = rep.with_name(rep.name.replace(".report.json", ".json"))
-        tail = job.stem.split(f"__{slug(run)}", 1)[1]
-        if tail and not re.fullmatch(r"__from_\d+", tail):
+        look, tail = job.stem.split(f"__{slug(run)}", 1)
+        if look not in looks or tail and not re.fullmatch(r"__from_\d+", tail):
             continue
         if clips is not None and job.parent.name not in {slug(c) for c in clips}:
             continue
@@ -104,6 +110,10 @@ def main(argv=None) -> int:
     ap.add_argument("--runs", default="1 lateral view 15 fps,1 lateral view 30 fps",
                     help="comma-separated run names")
     ap.add_argument("--clips", help="comma-separated clip names (default: every one tracked)")
+    ap.add_argument("--half-size", action="store_true",
+                    help="the runs on the footage halved (the suite's --half-size)")
+    ap.add_argument("--exposure-drift", action="store_true",
+                    help="the runs with the exposure drifting (the suite's --exposure-drift)")
     ap.add_argument("--enter", default="0.35,0.45,0.5,0.55,0.6,0.65")
     ap.add_argument("--clear", default="0.9,0.95,0.99")
     ap.add_argument("--weight", type=float, default=UNEXPLAINED_WEIGHT,
@@ -112,7 +122,8 @@ def main(argv=None) -> int:
     enters = [float(x) for x in a.enter.split(",")]
     clears = [float(x) for x in a.clear.split(",")]
     for run in a.runs.split(","):
-        jobs = run_reports(run, a.clips.split(",") if a.clips else None)
+        jobs = run_reports(run, a.clips.split(",") if a.clips else None,
+                           HALF * a.half_size + DRIFT * a.exposure_drift)
         if not jobs:
             raise SystemExit(f"{run}: no tracked reports in {CACHE} (run bench/suite.py)")
         print("\n".join(bar_table(run, jobs, enters, clears, a.weight)) + "\n")

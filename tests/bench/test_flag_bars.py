@@ -79,9 +79,11 @@ def test_the_unexplained_foreground_discounts_the_confidence_the_flag_reads():
 
 
 def test_the_reports_read_are_the_default_settings_of_each_start(tmp_path, monkeypatch):
-    """A run's reports tracked with other settings (their names carry them) or on another
-    run are passed over; each default one is read with the frame it started from."""
+    """A run's reports tracked with other settings (their names carry them), on another run
+    or on other footage (halved, its exposure drifting) are passed over; each default one is
+    read with the frame it started from, and the halved footage's when asked for."""
     import flag_bars
+    from suite_footage import HALF
 
     clip = tmp_path / "cmu_131_walk"
     clip.mkdir()
@@ -89,9 +91,14 @@ def test_the_reports_read_are_the_default_settings_of_each_start(tmp_path, monke
                  "__hand"):
         (clip / f"muybridge__3_views_15_fps{tail}.report.json").write_text("{}")
     (clip / "muybridge__3_views_30_fps.report.json").write_text("{}")
+    for look in ("muybridge_half", "muybridge_drift"):
+        (clip / f"{look}__3_views_15_fps.report.json").write_text("{}")
     monkeypatch.setattr(flag_bars, "CACHE", tmp_path)
     got = flag_bars.run_reports("3 views 15 fps")
     assert [(job.name, start) for job, start in got] == [
         ("muybridge__3_views_15_fps.json", 0), ("muybridge__3_views_15_fps__from_1.json", 1),
         ("muybridge__3_views_15_fps__from_2.json", 2)]
     assert flag_bars.run_reports("3 views 15 fps", ["CMU 05-01 walk"]) == []
+    assert [(job.name, start) for job, start in
+            flag_bars.run_reports("3 views 15 fps", footage=HALF)] == [
+        ("muybridge_half__3_views_15_fps.json", 0)]
