@@ -9,11 +9,12 @@ confidence, at its own bars): the report's confidences are what the flags are re
 the suite's runs need not be tracked again to see other bars. For every report
 ``bench/suite.py`` left in ``.cache/suite`` for the runs with the default settings (every
 clip, look and start, or the ``--clips`` named; the footage at full size, or halved or its
-exposure drifting, as the suite's ``--half-size`` and ``--exposure-drift``), each limb's flag is read again at each pair
-of bars from its confidence, with one view over one plus ``--weight`` times its unexplained
-foreground (``LimbCheck.flag_confidence``; ``confidence.reading``, each limb's flag on the
-frame before carried on), and scored as the suite scores flags (``suite.flag_counts``): % of
-the limbs over ``suite.BAD_LIMB_DEG`` off that are flagged / % of the flags on such limbs.
+exposure drifting, as the suite's ``--half-size`` and ``--exposure-drift``), each limb's
+flag is read again at each pair of bars from its confidence, with one view over one plus
+``--weight`` times its unexplained foreground (``LimbCheck.flag_confidence``;
+``confidence.reading``, each limb's flag on the frame before carried on), and scored as the
+suite scores flags (``suite.flag_counts``): % of the limbs over ``suite.BAD_LIMB_DEG`` off
+that are flagged / % of the flags on such limbs.
 The reports keep confidences to three places, so a count can differ from the suite's by the
 few limb-frames that lie on a bar. ``core.confidence.UNEXPLAINED_WEIGHT`` and the flags' bars
 were chosen this way (``docs/RESEARCH.md``).
