@@ -301,19 +301,40 @@ def armature_from_skeleton(sk: Skeleton, name: str, collection):
         if sk.parents[j] >= 0:
             eb.parent = data.edit_bones[sk.names[sk.parents[j]]]
         if sk.kinds[j] == HINGE:
-            eb.align_roll(Vector(T @ sk.axes[j]))
-            lo, hi = sk.limits[j]
-            if np.isfinite(lo) or np.isfinite(hi):
-                along = np.sign(np.dot(eb.z_axis, T @ sk.axes[j]))
-                limits[joint] = np.clip(sorted([along * lo, along * hi]), -np.pi, np.pi)
+            limits[joint] = roll_to_hinge(eb, T @ sk.axes[j], sk.limits[j])
         eb.head_radius = eb.tail_radius = radius.get(j, 0.0)
     bpy.ops.object.mode_set(mode="OBJECT")
     for j, joint in enumerate(sk.names):
         pb = obj.pose.bones[joint]
         kind = sk.kinds[j] if j else BALL
-        pb.lock_rotation = {FIXED: (True,) * 3, HINGE: (True, True, False)}.get(kind, (False,) * 3)
-        pb.rotation_mode = "XYZ" if kind == HINGE else "QUATERNION"
-        if joint in limits:
-            pb.use_ik_limit_z = True
-            pb.ik_min_z, pb.ik_max_z = limits[joint]
+        if kind == HINGE:
+            lock_to_hinge(pb, limits[joint])
+        else:
+            pb.lock_rotation = (kind == FIXED,) * 3
+            pb.rotation_mode = "QUATERNION"
     return obj
+
+
+def roll_to_hinge(eb, axis: np.ndarray, limits: tuple[float, float]
+                  ) -> tuple[float, float] | None:
+    """Roll an edit bone so that its local z is a hinge's ``axis`` (armature space, across
+    the bone); returns the hinge's ``limits`` (radians about ``axis``) as a range about that
+    z, which may point against it, or None for a hinge without limits (``lock_to_hinge``)."""
+    from mathutils import Vector
+
+    eb.align_roll(Vector(axis))
+    lo, hi = limits
+    if not (np.isfinite(lo) or np.isfinite(hi)):
+        return None
+    along = np.sign(np.dot(eb.z_axis, axis))
+    return tuple(np.clip(sorted([along * lo, along * hi]), -np.pi, np.pi))
+
+
+def lock_to_hinge(pb, z_limits: tuple[float, float] | None) -> None:
+    """Make a pose bone whose bone ``roll_to_hinge`` rolled a hinge about its local z, turning
+    within ``z_limits`` (radians, its inverse-kinematics limit) where given."""
+    pb.lock_rotation = (True, True, False)
+    pb.rotation_mode = "XYZ"
+    if z_limits is not None:
+        pb.use_ik_limit_z = True
+        pb.ik_min_z, pb.ik_max_z = z_limits
