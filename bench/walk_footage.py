@@ -28,6 +28,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from addon_dev import load_addon  # noqa: E402
 
 from core import se3  # noqa: E402
 from core.bvh import read_bvh, write_bvh  # noqa: E402
@@ -363,26 +366,43 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
                    joints: dict = JOINTS, distance: float | None = None, pan: float = 0.0):
     """Make the current scene ready to track rendered walk footage in ``folder``: the capture
     (folder/truth.bvh) imported as an armature and posed on frame 1, the bones of ``joints``
-    unlocked (as balls: Blender's bone axes are not the capture's hinge axes), envelope radii
-    from BLOBS, one camera and view per rendered view (as ``render`` filmed them, the first
-    one's pan keyed on every frame), frames 1..last_frame.
+    unlocked, a hinge's bone rolled so that its local z is the capture's hinge axis and
+    locked to turn about it alone, within its limits (as a user rigs an elbow), envelope
+    radii from BLOBS, one camera and view per rendered view (as ``render`` filmed them, the
+    first one's pan keyed on every frame), frames 1..last_frame.
     Needs the add-on registered; resetting the scene is the caller's (a factory reset disables
     an installed extension)."""
+    load_addon()  # the working tree as the package ``twist_mocap``, if not yet imported
+    from twist_mocap.twist_addon import bridge
     bpy.ops.import_anim.bvh(filepath=str(folder / "truth.bvh"), axis_forward="Y", axis_up="Z",
                             frame_start=1)
     arm = bpy.context.view_layer.objects.active
     scene = bpy.context.scene
     scene.frame_set(1)
     arm.animation_data_clear()  # the pose of frame 1 stays: the user's initial pose
+    posed = bridge.pose_from_armature(arm, bridge.skeleton_from_armature(arm))
+    hinges = {name: spec for name, spec in joints.items()
+              if isinstance(spec, dict) and spec["kind"] == "hinge"}
+    to_armature = np.array(arm.matrix_world.to_3x3().inverted())  # the capture's rest axes
     for pb in arm.pose.bones:
         pb.lock_rotation = (pb.name not in joints,) * 3
     bpy.context.view_layer.objects.active = arm
     bpy.ops.object.mode_set(mode="EDIT")
+    ranges = {name: bridge.roll_to_hinge(arm.data.edit_bones[name],
+                                         to_armature @ np.array(spec["axis"], float),
+                                         np.radians(spec.get("limits", [-np.inf, np.inf])))
+              for name, spec in hinges.items()}
     for eb in arm.data.edit_bones:
         spec = BLOBS.get(eb.name, {"radius": 0.0})
         r = 0.0 if spec is False else float(np.mean(spec.get("radii", [spec.get("radius")])))
         eb.head_radius = eb.tail_radius = r
     bpy.ops.object.mode_set(mode="OBJECT")
+    for name, z_limits in ranges.items():
+        bridge.lock_to_hinge(arm.pose.bones[name], z_limits)
+    bridge.set_pose(arm, bridge.skeleton_from_armature(arm), *posed)  # the rolled bones too
+    for name in hinges:  # what the capture turns off the axis as given (a tenth of a degree)
+        pb = arm.pose.bones[name]
+        pb.rotation_euler = (0.0, 0.0, pb.rotation_euler[2])
     scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
     scene.frame_start, scene.frame_end = 1, last_frame
     scene.twist.armature = arm

@@ -39,6 +39,49 @@ def test_example_scene_is_ready_to_track(bpy_module, registered, name, views, fr
     assert len(sk.dof_names()) >= 10 and sk.blobs
 
 
+def test_the_walk_example_is_the_capture_posed_with_hinge_knees_and_elbows(bpy_module,
+                                                                          registered):
+    """The walk's armature is the paper's body with the lower back free: its knees and
+    elbows are hinges about the capture's own axes, within their limits (their bones rolled
+    to those axes, which leaves the first frame's pose as the capture has it), and every
+    other tracked joint a ball."""
+    import sys
+
+    sys.path.insert(0, str(EXAMPLES.parent / "bench"))
+    from walk_footage import SPINE_JOINTS
+
+    from core.bvh import read_bvh
+    from core.skeleton import BALL, HINGE, skeleton_from_bvh
+
+    bpy = bpy_module
+    bpy.ops.wm.open_mainfile(filepath=str(EXAMPLES / "walk_3view.blend"))
+    scene = bpy.context.scene
+    scene.frame_set(scene.frame_start)
+    bridge = registered.twist_addon.bridge
+    arm = scene.twist.armature
+    sk = bridge.skeleton_from_armature(arm)
+    tracked = {sk.names[j]: sk.kinds[j] for j in range(sk.n_joints) if sk.parents[j] >= 0
+               and sk.kinds[j] != "fixed"}
+    assert set(tracked) == set(SPINE_JOINTS)
+    assert len(sk.dof_names()) == 22
+    for name, spec in SPINE_JOINTS.items():
+        j = sk.index(name)
+        if spec == "ball":
+            assert tracked[name] == BALL, name
+            continue
+        assert tracked[name] == HINGE, name
+        axis = np.array(spec["axis"]) / np.linalg.norm(spec["axis"])
+        assert abs(sk.axes[j] @ axis) > 0.9999, (name, sk.axes[j])
+        turn = np.sign(sk.axes[j] @ axis) * np.degrees(sk.limits[j])
+        assert np.allclose(sorted(turn), spec["limits"], atol=1e-3), (name, turn)
+    truth_bvh = read_bvh(EXAMPLES / "walk_3view" / "truth.bvh")
+    capture = skeleton_from_bvh(truth_bvh)
+    R, p = (x[0] for x in truth_bvh.poses())
+    at = sk.world_positions(*bridge.pose_from_armature(arm, sk))
+    want = capture.world_positions(R, p)[[capture.index(n) for n in sk.names]]
+    assert np.abs(at - want).max() < 1e-3  # metres
+
+
 def test_an_unposed_template_tracked_says_which_frames_to_check(bpy_module, registered):
     """The woman's template is not posed over her: Track keys the frames but warns,
     lists them in the Results panel and marks on the timeline where each limb's doubt
