@@ -360,6 +360,27 @@ def twist_about(R: np.ndarray, axis: np.ndarray) -> float:
     return float(2 * np.arctan2(np.sin(angle / 2) * along, np.cos(angle / 2)))
 
 
+MIN_BEND = 10.0  # degrees a bone must be bent from its rest direction to show its hinge
+
+
+def bend_hinge(direction: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, float]:
+    """The hinge that bends a bone as its joint's rotation ``R`` does: the unit axis normal
+    to the bone's rest ``direction`` and its turned one ``R @ direction`` (so across the
+    bone), and the angle (radians, in (0, pi)) about that axis from the one to the other; a
+    twist about the bone, which a hinge cannot hold, is left out. For a limb straight at
+    rest it is the normal of the plane the limb bends in. ValueError where the bone is
+    turned less than ``MIN_BEND`` degrees from its rest direction (or right round): no
+    plane shows the axis."""
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    turned = R @ d
+    normal = np.cross(d, turned)
+    angle = float(np.arctan2(np.linalg.norm(normal), d @ turned))
+    if not np.radians(MIN_BEND) <= angle <= np.pi - np.radians(MIN_BEND):
+        raise ValueError(f"bent {np.degrees(angle):.0f} degrees from its rest direction, "
+                         f"under {MIN_BEND:g}: no bend shows its axis")
+    return normal / np.linalg.norm(normal), angle
+
+
 # --- templates -------------------------------------------------------------------------
 def _build(spec, end_sites=None, limits=None) -> Skeleton:
     """A template from its joints (name, parent, offset, kind[, axis]), end sites and hinge

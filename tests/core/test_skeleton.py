@@ -8,8 +8,10 @@ from core.bvh import read_bvh
 from core.skeleton import (
     BALL,
     HINGE,
+    MIN_BEND,
     TRUNK_RADIUS,
     Skeleton,
+    bend_hinge,
     human_template,
     planar_chain_template,
     planar_quadruped_template,
@@ -243,3 +245,26 @@ def test_twist_about_is_the_quaternions_twist():
         # the swing left after taking the twist out moves the axis and turns nothing about it
         swing = R @ se3.exp_so3(-tau * axis)
         assert abs(se3.log_so3(swing) @ axis) < 1e-9
+
+
+def test_a_bones_bend_gives_back_the_hinge_that_bent_it_whatever_its_twist():
+    """A bone bent about an axis across it, then twisted about itself: the hinge read from
+    its rest and turned directions is that axis (its sign the bend's) and angle, and turning
+    the rest direction by it gives the turned one; a bone turned too little to show a plane,
+    or right round, is refused."""
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        d = rng.normal(size=3)
+        d /= np.linalg.norm(d)
+        axis = np.cross(d, rng.normal(size=3))
+        axis /= np.linalg.norm(axis)
+        angle = rng.uniform(np.radians(MIN_BEND) + 0.01, np.pi - np.radians(MIN_BEND) - 0.01)
+        R = se3.exp_so3(axis * angle) @ se3.exp_so3(d * rng.uniform(-2, 2))  # twist first
+        got_axis, got_angle = bend_hinge(3 * d, R)
+        np.testing.assert_allclose(got_axis, axis, atol=1e-9)
+        assert got_angle == pytest.approx(angle, abs=1e-9)
+        np.testing.assert_allclose(se3.exp_so3(got_axis * got_angle) @ d, R @ d, atol=1e-9)
+    d = np.array([0.0, -1.0, 0.0])
+    for degrees in (0.0, MIN_BEND - 1, 180.0):
+        with pytest.raises(ValueError, match="no bend shows its axis"):
+            bend_hinge(d, se3.exp_so3(np.array([1.0, 0, 0]) * np.radians(degrees)))
