@@ -7,6 +7,7 @@ from . import (
     cycle,
     export,
     fit,
+    hinges,
     markers,
     overlay,
     panels,
@@ -19,8 +20,8 @@ from . import (
     views,
 )
 
-MODULES = (properties, views, templates, track, markers, fit, refine, body, smooth, cycle,
-           retarget, export, panels, overlay)
+MODULES = (properties, views, templates, hinges, track, markers, fit, refine, body, smooth,
+           cycle, retarget, export, panels, overlay)
 
 
 def register():

@@ -83,7 +83,9 @@ class TWIST_PT_armature(_TwistPanel, bpy.types.Panel):
         box.operator("twist.fit_pose", text="Fit Pose and Bone Lengths",
                         icon="CON_KINEMATIC").fit_lengths = True
         layout.operator_menu_enum("twist.add_template_armature", "template", icon="ARMATURE_DATA")
-        layout.operator("twist.size_blobs", icon="MESH_UVSPHERE")
+        row = layout.row(align=True)
+        row.operator("twist.make_hinges", icon="CON_ROTLIMIT")
+        row.operator("twist.size_blobs", icon="MESH_UVSPHERE")
 
 
 class TWIST_PT_track(_TwistPanel, bpy.types.Panel):
