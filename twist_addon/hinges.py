@@ -37,7 +37,21 @@ BEND_RANGE = (-10.0, 165.0)  # degrees from the rest direction: a little past st
 def make_hinges(arm, names: list[str], bend_range=BEND_RANGE) -> dict[str, float]:
     """Make the bones ``names`` of ``arm`` hinges (the module's rule) within ``bend_range``
     (degrees), at the current frame's pose; returns each one's bend there (degrees).
-    BridgeError, with nothing changed, naming every bone that cannot be one."""
+    BridgeError, with nothing changed, naming every bone that cannot be one. The armature
+    is left in the mode it was in (an edit in progress is taken in first)."""
+    view_layer = bpy.context.view_layer
+    active, view_layer.objects.active = view_layer.objects.active, arm
+    mode = arm.mode
+    bpy.ops.object.mode_set(mode="OBJECT")
+    try:
+        return _make_hinges(arm, names, bend_range)
+    finally:
+        bpy.ops.object.mode_set(mode=mode)
+        view_layer.objects.active = active
+
+
+def _make_hinges(arm, names: list[str], bend_range) -> dict[str, float]:
+    """``make_hinges`` on ``arm``, active and in object mode."""
     sk = skeleton_from_armature(arm)
     R, root = pose_from_armature(arm, sk)
     C = bone_frames(arm)
@@ -57,9 +71,6 @@ def make_hinges(arm, names: list[str], bend_range=BEND_RANGE) -> dict[str, float
     if problems:
         raise BridgeError("cannot make hinges: " + "; ".join(problems))
     to_armature = np.linalg.inv(np.array(arm.matrix_world.to_3x3()))
-    view_layer = bpy.context.view_layer
-    active, view_layer.objects.active = view_layer.objects.active, arm
-    mode = arm.mode
     bpy.ops.object.mode_set(mode="EDIT")
     ranges = {name: roll_to_hinge(arm.data.edit_bones[name], to_armature @ axis,
                                   np.radians(bend_range))
@@ -73,8 +84,6 @@ def make_hinges(arm, names: list[str], bend_range=BEND_RANGE) -> dict[str, float
     for name in hinges:  # about z alone: what rounding left on the locked channels goes
         pb = arm.pose.bones[name]
         pb.rotation_euler = (0.0, 0.0, pb.rotation_euler[2])
-    bpy.ops.object.mode_set(mode=mode)
-    view_layer.objects.active = active
     return {name: float(np.degrees(angle)) for name, (_, angle) in hinges.items()}
 
 

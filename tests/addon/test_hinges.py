@@ -36,8 +36,9 @@ def _select(arm, names):
 def test_bent_knees_and_elbows_become_hinges_about_the_captures_axes_the_pose_kept(
         bpy_module, registered):
     """The capture bends its knees and elbows about fixed axes (``JOINTS``'s); made hinges
-    from their bend on the first frame, each bone turns about that axis alone, bending
-    positive within its range, and every joint stays where the capture has it."""
+    in Pose Mode from their bend on the first frame, each bone turns about that axis alone,
+    bending positive within its range, every joint stays where the capture has it, and the
+    armature stays in Pose Mode."""
     from core.skeleton import HINGE
 
     bpy = bpy_module
@@ -45,8 +46,10 @@ def test_bent_knees_and_elbows_become_hinges_about_the_captures_axes_the_pose_ke
     bridge = registered.twist_addon.bridge
     sk = bridge.skeleton_from_armature(arm)
     before = sk.world_positions(*bridge.pose_from_armature(arm, sk))
+    bpy.ops.object.mode_set(mode="POSE")  # where the bones are selected
     _select(arm, HINGES)
     assert bpy.ops.twist.make_hinges() == {"FINISHED"}
+    assert arm.mode == "POSE"
     sk = bridge.skeleton_from_armature(arm)
     R, root = bridge.pose_from_armature(arm, sk)
     np.testing.assert_allclose(sk.world_positions(R, root), before, atol=1e-5)  # metres
