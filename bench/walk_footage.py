@@ -381,28 +381,21 @@ def tracking_scene(bpy, folder: Path, views: list[str], last_frame: int, images:
     scene.frame_set(1)
     arm.animation_data_clear()  # the pose of frame 1 stays: the user's initial pose
     posed = bridge.pose_from_armature(arm, bridge.skeleton_from_armature(arm))
-    hinges = {name: spec for name, spec in joints.items()
-              if isinstance(spec, dict) and spec["kind"] == "hinge"}
-    to_armature = np.array(arm.matrix_world.to_3x3().inverted())  # the capture's rest axes
     for pb in arm.pose.bones:
         pb.lock_rotation = (pb.name not in joints,) * 3
     bpy.context.view_layer.objects.active = arm
     bpy.ops.object.mode_set(mode="EDIT")
-    ranges = {name: bridge.roll_to_hinge(arm.data.edit_bones[name],
-                                         to_armature @ np.array(spec["axis"], float),
-                                         np.radians(spec.get("limits", [-np.inf, np.inf])))
-              for name, spec in hinges.items()}
     for eb in arm.data.edit_bones:
         spec = BLOBS.get(eb.name, {"radius": 0.0})
         r = 0.0 if spec is False else float(np.mean(spec.get("radii", [spec.get("radius")])))
         eb.head_radius = eb.tail_radius = r
     bpy.ops.object.mode_set(mode="OBJECT")
-    for name, z_limits in ranges.items():
-        bridge.lock_to_hinge(arm.pose.bones[name], z_limits)
-    bridge.set_pose(arm, bridge.skeleton_from_armature(arm), *posed)  # the rolled bones too
-    for name in hinges:  # what the capture turns off the axis as given (a tenth of a degree)
-        pb = arm.pose.bones[name]
-        pb.rotation_euler = (0.0, 0.0, pb.rotation_euler[2])
+    # the hinges about the capture's axes (its rest axes are the world's), posed as on frame
+    # 1 but for the tenth of a degree the capture turns off an axis as given
+    bridge.rig_hinges(arm, {name: (np.array(spec["axis"], float),
+                                   np.radians(spec.get("limits", [-np.inf, np.inf])))
+                            for name, spec in joints.items()
+                            if isinstance(spec, dict) and spec["kind"] == "hinge"}, *posed)
     scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
     scene.frame_start, scene.frame_end = 1, last_frame
     scene.twist.armature = arm

@@ -330,6 +330,28 @@ def roll_to_hinge(eb, axis: np.ndarray, limits: tuple[float, float]
     return tuple(np.clip(sorted([along * lo, along * hi]), -np.pi, np.pi))
 
 
+def rig_hinges(arm, hinges: dict[str, tuple[np.ndarray, tuple[float, float]]],
+               R: np.ndarray, root_position: np.ndarray) -> None:
+    """Make bones of ``arm`` (active, in object mode) hinges: each of ``hinges`` (name: its
+    axis, world, across the bone, and its limits, radians about it) rolled to its axis and
+    locked there (``roll_to_hinge``, ``lock_to_hinge``); then the armature posed at the core
+    pose (``R``, ``root_position``, ``set_pose``), each hinge about its local z alone (what
+    its locked channels would hold, a turn off the axis or rounding, goes)."""
+    import bpy
+
+    to_armature = np.linalg.inv(np.array(arm.matrix_world.to_3x3()))
+    bpy.ops.object.mode_set(mode="EDIT")
+    ranges = {name: roll_to_hinge(arm.data.edit_bones[name], to_armature @ axis, limits)
+              for name, (axis, limits) in hinges.items()}
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for name, z_range in ranges.items():
+        lock_to_hinge(arm.pose.bones[name], z_range)
+    set_pose(arm, skeleton_from_armature(arm), R, root_position)
+    for name in hinges:
+        pb = arm.pose.bones[name]
+        pb.rotation_euler = (0.0, 0.0, pb.rotation_euler[2])
+
+
 def lock_to_hinge(pb, z_limits: tuple[float, float] | None) -> None:
     """Make a pose bone whose bone ``roll_to_hinge`` rolled a hinge about its local z, turning
     within ``z_limits`` (radians, its inverse-kinematics limit) where given."""

@@ -24,10 +24,8 @@ from .armature_action import ArmatureAction
 from .bridge import (
     BridgeError,
     bone_frames,
-    lock_to_hinge,
     pose_from_armature,
-    roll_to_hinge,
-    set_pose,
+    rig_hinges,
     skeleton_from_armature,
 )
 
@@ -70,20 +68,10 @@ def _make_hinges(arm, names: list[str], bend_range) -> dict[str, float]:
                 problems.append(f"{name} is {e}; bend it the way it bends on this frame")
     if problems:
         raise BridgeError("cannot make hinges: " + "; ".join(problems))
-    to_armature = np.linalg.inv(np.array(arm.matrix_world.to_3x3()))
-    bpy.ops.object.mode_set(mode="EDIT")
-    ranges = {name: roll_to_hinge(arm.data.edit_bones[name], to_armature @ axis,
-                                  np.radians(bend_range))
-              for name, (axis, _) in hinges.items()}
-    bpy.ops.object.mode_set(mode="OBJECT")
-    for name, z_range in ranges.items():
-        lock_to_hinge(arm.pose.bones[name], z_range)
     for name, (axis, angle) in hinges.items():
         R[sk.index(name)] = se3.exp_so3(axis * angle)
-    set_pose(arm, skeleton_from_armature(arm), R, root)
-    for name in hinges:  # about z alone: what rounding left on the locked channels goes
-        pb = arm.pose.bones[name]
-        pb.rotation_euler = (0.0, 0.0, pb.rotation_euler[2])
+    rig_hinges(arm, {name: (axis, np.radians(bend_range)) for name, (axis, _) in hinges.items()},
+               R, root)
     return {name: float(np.degrees(angle)) for name, (_, angle) in hinges.items()}
 
 
