@@ -319,16 +319,21 @@ class FrameFit:
         fgs = self._search.usable(est, views, fgs)
         return *self._search.turn(est, views, fgs), (views, fgs)
 
-    def _refuted_chain(self, est: BodyPose, searched: BodyPose, limb, backdrops: tuple
-                       ) -> tuple[BodyPose, list] | None:
+    def _refuted_chain(self, est: BodyPose, searched: BodyPose, limb, backdrops: tuple,
+                       searched_on: tuple) -> tuple[BodyPose, list] | None:
         """``est`` with the search's turns of ``limb`` and of the limbs below it (which the
         search placed for it), and their degrees of freedom, where the backdrops refute
-        those limbs at ``est`` and bear them out so turned; else None. Of two or more views
-        with a backdrop (``backdrops``: the search's views and their
-        ``silhouette.distance_to_body`` maps, None for a view it left out), one must show a
-        point of their bones where the body cannot be now (``Limbs.bone_off_body``), and
-        none one there once turned. A still backdrop's pixel is a plain negative: the body
-        is not there. A joint several limbs hang from (the trunk's) is not a limb's."""
+        those limbs at ``est`` and bear them out so turned, and no view's outline of them
+        is against the turn; else None. Of two or more views with a backdrop
+        (``backdrops``: the search's views and their ``silhouette.distance_to_body`` maps,
+        None for a view it left out), one must show a point of their bones where the body
+        cannot be now (``Limbs.bone_off_body``), and none one there once turned. A still
+        backdrop's pixel is a plain negative: the body is not there. But one view's
+        negative is not every view's evidence: where another view sees a limb of the chain
+        on its silhouette and scores it worse turned (``_seen_outlines``), that view's
+        silhouette may be what is short of the limb, and the limb keeps its predicted
+        motion unless the other gates bear the turn out. A joint several limbs hang from
+        (the trunk's) is not a limb's. ``searched_on``: as ``_seen_outlines``."""
         chain = self._chain(limb)
         if not backdrops or chain is None:
             return None
@@ -337,9 +342,26 @@ class FrameFit:
         now, then = (self._limbs.bone_off_body(Kinematics(self.skeleton, p), *backdrops)[rows]
                      for p in (est, turned))
         have = np.all(~np.isnan(now) & ~np.isnan(then), axis=0)
-        if have.sum() >= 2 and np.all(then[:, have] == 0) and np.any(now[:, have] > 0):
-            return turned, [d for lb in chain for d in lb.dofs]
-        return None
+        if not (have.sum() >= 2 and np.all(then[:, have] == 0) and np.any(now[:, have] > 0)):
+            return None
+        for lb in chain:
+            now_cost, then_cost, margin = self._seen_outlines(est, turned, lb, searched_on)
+            if np.any(then_cost - now_cost > margin):
+                return None
+        return turned, [d for lb in chain for d in lb.dofs]
+
+    def _seen_outlines(self, est: BodyPose, turned: BodyPose, limb, searched_on: tuple
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """In each view that sees ``limb``, its outline's score at ``est`` and at ``turned``
+        and the search's margin (``LimbSearch.view_costs``; ``searched_on``: the search's
+        views and foreground maps). A view sees the limb where its score at either pose is
+        larger than the margin: the pixels the rest of the body leaves free score, those
+        under it or unsure do not, and a limb that lies on them both ways is not seen
+        there."""
+        cost, area = self._search.view_costs(limb, [est, turned], *searched_on)
+        margin = self.settings.limb_search * area
+        sees = ~np.isnan(area) & (np.abs(cost).max(axis=0) > margin)
+        return cost[0, sees], cost[1, sees], margin[sees]
 
     def _chain(self, limb) -> list | None:
         """The search's limbs that ``limb``'s joint moves, itself first, where they hang in
@@ -357,23 +379,18 @@ class FrameFit:
         better than the search's margin (``LimbSearch.view_costs``), or where two or more
         see it and every one of them finds it off the body now and on the body turned (its
         score over the margin, then under minus the margin: more of the outline on the
-        backdrop than on the silhouette, then the other way round); else None. A view sees
-        the limb where its score at either pose is larger than the margin: the pixels the
-        rest of the body leaves free score, those under it or unsure do not, and a limb
-        that lies on them both ways is not seen there. ``searched_on``: the search's views
-        and foreground maps (``_search_limbs``). Not for a joint several limbs hang from: its
-        own segment's outline is scored with the limbs below it taken out, and would turn
-        onto their silhouettes."""
+        backdrop than on the silhouette, then the other way round); else None. Which views
+        see the limb: ``_seen_outlines``. ``searched_on``: the search's views and foreground
+        maps (``_search_limbs``). Not for a joint several limbs hang from: its own
+        segment's outline is scored with the limbs below it taken out, and would turn onto
+        their silhouettes."""
         if not searched_on or self._chain(limb) is None:
             return None
         turned = _with_turns(est, searched, [limb])
-        cost, area = self._search.view_costs(limb, [est, turned], *searched_on)
-        margin = self.settings.limb_search * area
-        sees = ~np.isnan(area) & (np.abs(cost).max(axis=0) > margin)
-        now, then, m = cost[0, sees], cost[1, sees], margin[sees]
-        if sees.sum() >= OUTLINE_VIEWS and np.all(now - then > m):
+        now, then, m = self._seen_outlines(est, turned, limb, searched_on)
+        if len(m) >= OUTLINE_VIEWS and np.all(now - then > m):
             return turned
-        if sees.sum() >= 2 and np.all(now > m) and np.all(then < -m):
+        if len(m) >= 2 and np.all(now > m) and np.all(then < -m):
             return turned
         return None
 
@@ -441,7 +458,7 @@ class FrameFit:
         for limb in self._search.limbs:
             if self.skeleton.names[limb.joint] not in turned:
                 continue
-            refuted = self._refuted_chain(out, searched, limb, backdrops)
+            refuted = self._refuted_chain(out, searched, limb, backdrops, searched_on)
             if refuted is not None:
                 out, dofs = refuted
             elif (outlined := self._outlines_bear_out(out, searched, limb,

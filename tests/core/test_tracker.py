@@ -840,6 +840,39 @@ def test_outlines_alone_turn_a_limb_where_three_views_bear_it_out_or_two_refute_
     assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, without)) is None
 
 
+def test_one_views_backdrop_does_not_turn_a_limb_other_views_see_where_it_is(body):
+    """The refutation's own case, and where it must not decide: the arm held out, every
+    view's silhouette the body's own, but the side view's short of the arm (its threshold
+    missed it, or the backdrop took it in). That view shows the arm's bone over its
+    backdrop, and the search's turn (the arm let down beside the trunk) puts it on the body
+    everywhere, which alone turned the arm; the two other views see the arm on their
+    silhouettes where it is and score it worse let down, so it stays. With the side view's
+    silhouette whole and the arm truly let down, the backdrop's word turns it."""
+    sk, rest = body
+    held_out = _swung(sk, _swung(sk, rest, "RightShoulder", -60, 1), "RightShoulder", -50, 2)
+    tracker = Tracker(sk, [[render(sk, held_out, c)] for c in range(3)], CALIBRATED)
+    limb = next(lb for lb in tracker._search.limbs if sk.names[lb.joint] == "RightShoulder")
+
+    def silhouettes(pose):
+        return [np.where(render(sk, pose, c) != render(sk, pose, c)[0, 0], sil.FOREGROUND,
+                         sil.BACKDROP).astype(np.uint8) for c in range(3)]
+
+    def refuted(est, fgs):
+        return tracker._refuted_chain(est, rest, limb, (
+            est.views, [sil.distance_to_body(f) for f in fgs]), (est.views, fgs))
+
+    fgs = silhouettes(held_out)
+    arm = np.zeros(fgs[0].shape, bool)
+    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, held_out).segments)
+    below = [i for i, b in enumerate(sk.blobs)
+             if b.joint in (sk.index("RightShoulder"), sk.index("RightElbow"))]
+    paint(arm, held_out.views[0], A[below], C[below], (0, 0, arm.shape[1], arm.shape[0]))
+    short = [np.where(arm, sil.BACKDROP, fgs[0]).astype(np.uint8)] + fgs[1:]
+    assert refuted(held_out, short) is None
+    turned = refuted(held_out, silhouettes(rest))
+    assert turned is not None and _limb_errors(sk, turned[0], rest).max() < 1e-6
+
+
 def test_a_limb_the_search_turned_is_predicted_where_it_was_on_the_next_frame(body):
     """The body holds an arm out and stands still, but between the first two frames the arm
     jumps 50 degrees and stays there. The limb search turns it onto the second frame's arm;
