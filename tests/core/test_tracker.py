@@ -806,6 +806,24 @@ def test_a_lost_limb_the_backdrop_refutes_in_a_view_is_turned_back_without_brigh
     assert joint in res.searched
 
 
+def _silhouettes(sk, pose: BodyPose) -> list[np.ndarray]:
+    """Each view's foreground map of the rendered ``pose``: the body's pixels foreground,
+    the rest backdrop."""
+    return [np.where(render(sk, pose, c) != render(sk, pose, c)[0, 0], sil.FOREGROUND,
+                     sil.BACKDROP).astype(np.uint8) for c in range(len(pose.views))]
+
+
+def _right_arm(sk, pose: BodyPose, view: int, shape) -> np.ndarray:
+    """The pixels (a mask of ``shape``) the right upper arm's and forearm's blobs cover in
+    ``view`` at ``pose``."""
+    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, pose).segments)
+    arm = np.zeros(shape, bool)
+    below = [i for i, b in enumerate(sk.blobs)
+             if b.joint in (sk.index("RightShoulder"), sk.index("RightElbow"))]
+    paint(arm, pose.views[view], A[below], C[below], (0, 0, shape[1], shape[0]))
+    return arm
+
+
 def test_outlines_alone_turn_a_limb_where_three_views_bear_it_out_or_two_refute_it(body):
     """The evidence rules for a turn whose pixels say nothing (a lost limb's pixels are what
     it wrongly covered): the arm, held out forward and to the side, seen in all three views
@@ -818,25 +836,16 @@ def test_outlines_alone_turn_a_limb_where_three_views_bear_it_out_or_two_refute_
     lost = _swung(sk, truth, "RightShoulder", 45, 1)
     tracker = Tracker(sk, [[render(sk, truth, c)] for c in range(3)], CALIBRATED)
     limb = next(lb for lb in tracker._search.limbs if sk.names[lb.joint] == "RightShoulder")
-    fgs = [np.where(render(sk, truth, c) != render(sk, truth, c)[0, 0], sil.FOREGROUND,
-                    sil.BACKDROP).astype(np.uint8) for c in range(3)]
+    fgs = _silhouettes(sk, truth)
     turned = tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs))
     assert turned is not None and _limb_errors(sk, turned, truth).max() < 1e-6
     two = tracker._outlines_bear_out(lost, truth, limb, (truth.views, fgs[:2] + [None]))
     assert two is not None and _limb_errors(sk, two, truth).max() < 1e-6
-
-    def arm_at(pose, view):
-        A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, pose).segments)
-        arm = np.zeros(fgs[view].shape, bool)
-        below = [i for i, b in enumerate(sk.blobs)
-                 if b.joint in (sk.index("RightShoulder"), sk.index("RightElbow"))]
-        paint(arm, pose.views[view], A[below], C[below], (0, 0, arm.shape[1], arm.shape[0]))
-        return arm
-
-    shown = fgs[:1] + [np.where(arm_at(lost, 1), sil.FOREGROUND, fgs[1]).astype(np.uint8),
-                       None]
+    shown = fgs[:1] + [np.where(_right_arm(sk, lost, 1, fgs[1].shape), sil.FOREGROUND,
+                                fgs[1]).astype(np.uint8), None]
     assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, shown)) is None
-    without = fgs[:2] + [np.where(arm_at(truth, 2), sil.BACKDROP, fgs[2]).astype(np.uint8)]
+    without = fgs[:2] + [np.where(_right_arm(sk, truth, 2, fgs[2].shape), sil.BACKDROP,
+                                  fgs[2]).astype(np.uint8)]
     assert tracker._outlines_bear_out(lost, truth, limb, (truth.views, without)) is None
 
 
@@ -853,23 +862,15 @@ def test_one_views_backdrop_does_not_turn_a_limb_other_views_see_where_it_is(bod
     tracker = Tracker(sk, [[render(sk, held_out, c)] for c in range(3)], CALIBRATED)
     limb = next(lb for lb in tracker._search.limbs if sk.names[lb.joint] == "RightShoulder")
 
-    def silhouettes(pose):
-        return [np.where(render(sk, pose, c) != render(sk, pose, c)[0, 0], sil.FOREGROUND,
-                         sil.BACKDROP).astype(np.uint8) for c in range(3)]
-
     def refuted(est, fgs):
         return tracker._refuted_chain(est, rest, limb, (
             est.views, [sil.distance_to_body(f) for f in fgs]), (est.views, fgs))
 
-    fgs = silhouettes(held_out)
-    arm = np.zeros(fgs[0].shape, bool)
-    A, C = raycast.blob_frames(sk.blobs, Kinematics(sk, held_out).segments)
-    below = [i for i, b in enumerate(sk.blobs)
-             if b.joint in (sk.index("RightShoulder"), sk.index("RightElbow"))]
-    paint(arm, held_out.views[0], A[below], C[below], (0, 0, arm.shape[1], arm.shape[0]))
+    fgs = _silhouettes(sk, held_out)
+    arm = _right_arm(sk, held_out, 0, fgs[0].shape)
     short = [np.where(arm, sil.BACKDROP, fgs[0]).astype(np.uint8)] + fgs[1:]
     assert refuted(held_out, short) is None
-    turned = refuted(held_out, silhouettes(rest))
+    turned = refuted(held_out, _silhouettes(sk, rest))
     assert turned is not None and _limb_errors(sk, turned[0], rest).max() < 1e-6
 
 
