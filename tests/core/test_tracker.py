@@ -809,8 +809,9 @@ def test_a_lost_limb_the_backdrop_refutes_in_a_view_is_turned_back_without_brigh
 def _silhouettes(sk, pose: BodyPose) -> list[np.ndarray]:
     """Each view's foreground map of the rendered ``pose``: the body's pixels foreground,
     the rest backdrop."""
-    return [np.where(render(sk, pose, c) != render(sk, pose, c)[0, 0], sil.FOREGROUND,
-                     sil.BACKDROP).astype(np.uint8) for c in range(len(pose.views))]
+    images = [render(sk, pose, c) for c in range(len(pose.views))]
+    return [np.where(img != img[0, 0], sil.FOREGROUND, sil.BACKDROP).astype(np.uint8)
+            for img in images]
 
 
 def _right_arm(sk, pose: BodyPose, view: int, shape) -> np.ndarray:
