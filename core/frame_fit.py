@@ -58,6 +58,7 @@ from .solver import (
     NormalEquations,
     channel_rows,
     mixture_cost,
+    point_noise,
     robust_scale,
     solve,
     support_posterior,
@@ -124,6 +125,7 @@ class PointSet:
     ref: np.ndarray  # (N, 3) reference-frame point
     value: np.ndarray  # (N, C) each channel's value in that frame (C = 1: brightness alone)
     weight: np.ndarray  # (N,) rim weight times the set's weight
+    slope: np.ndarray  # (N, C) each channel's squared gradient there, per level pixel squared
     lengths: tuple[int, ...] = ()  # points per frame, when several frames are joined
 
     def key_points(self) -> np.ndarray:
@@ -141,8 +143,16 @@ class PointSet:
             return sets[0]
         return PointSet(sets[0].view, *(np.concatenate([getattr(ps, f) for ps in sets])
                                         for f in ("seg_joint", "blob", "ref", "value",
-                                                  "weight")),
+                                                  "weight", "slope")),
                         tuple(len(ps.value) for ps in sets))
+
+
+def _views_seeing(sets: list[PointSet], n_joints: int) -> np.ndarray:
+    """How many views' point sets hold points of each joint's segment, (n_joints,)."""
+    seen = np.zeros((max((ps.view for ps in sets), default=-1) + 1, n_joints), dtype=bool)
+    for ps in sets:
+        seen[ps.view] |= np.bincount(ps.seg_joint, minlength=n_joints) > 0
+    return seen.sum(0)
 
 
 @dataclass
@@ -150,7 +160,8 @@ class _Samples:
     """One pose's look at the point sets on one level."""
 
     costs: np.ndarray  # (all points,) robust cost, NaN where hidden or off the image
-    parts: list  # per set: (indices of usable points, world points, image gradients, residuals)
+    parts: list  # per set: (indices of usable points, world points, image gradients, residuals,
+    # their noise scales: ``solver.point_noise``)
     inside: np.ndarray  # (views,) fraction of each view's points inside its image
     sigmas: list  # per set, its points' noise scales (N,)
     shape_cost: float = 0.0  # the silhouette term's cost
@@ -575,9 +586,11 @@ class FrameFit:
         g = kin.segments.take(seg_joint, 0)
         d = hits.world[ok] - g[:, :3, 3]
         ref = np.einsum("nba,nb->na", g[:, :3, :3], d)
-        value = level.values(pix_l).astype(float)
+        at = level.values(pix_l, derivatives=True).astype(float)
+        C = level.channels
         rim = np.clip(np.sqrt(hits.rim[ok]) / self.settings.rim_width, 0, 1)
-        return PointSet(view, seg_joint, label, ref, value, rim * set_weight)
+        return PointSet(view, seg_joint, label, ref, at[:, :C], rim * set_weight,
+                        at[:, C:2 * C] ** 2 + at[:, 2 * C:] ** 2)
 
     def _backdrop_pixels(self, view: int, frame: int, lv: int, pix: np.ndarray,
                          blob: np.ndarray, lost: Collection[str]) -> np.ndarray:
@@ -614,7 +627,10 @@ class FrameFit:
         where the point is hidden by another blob or off the image) and what the rows need.
         ``levels`` holds each view's pyramid level for tracker level ``level``. Without
         ``sigmas`` the points' noise scales are measured here (``_sigmas``): a level's
-        starting pose sets them, and its candidates are costed with them."""
+        starting pose sets them, and its candidates are costed with them. The previous
+        frame's points of segments two or more views see are noisier by the blobs' misfit
+        (``solver.point_noise``, ``registration_noise``); the key frame's points, the anchor
+        against drift, and a segment one view alone sees keep their set's noise."""
         s = self.settings
         costs, parts = [], []
         n_pts, n_inside = np.zeros(self.seq.n_views), np.zeros(self.seq.n_views)
@@ -636,6 +652,7 @@ class FrameFit:
                 shape_cost += s.silhouette * mm.cost
                 shape_parts.append(_ShapePull(mm, grid, (x0, y0), full))
         measured = []
+        several = _views_seeing(sets, self.skeleton.n_joints) > 1
         for k, ps in enumerate(sets):
             world = kin.world_points(ps.seg_joint, ps.ref)
             pix = est.views[ps.view].project(world)
@@ -657,48 +674,52 @@ class FrameFit:
             vals = vals.take(ok, 0)
             r = vals[:, :C] - ps.value[ok]
             c = np.full(len(pix), np.nan)
-            c[ok] = ps.weight[ok] * mixture_cost(r, sigma[ok], s.outlier_density)
+            misfit = several.take(ps.seg_joint) & ~ps.key_points()
+            misplaced = s.registration_noise * misfit.take(ok)
+            noise = point_noise(sigma[ok], ps.slope[ok], misplaced[:, None])
+            c[ok] = ps.weight[ok] * mixture_cost(r, noise, s.outlier_density)
             costs.append(c)
             grad = np.stack([vals[:, C:2 * C], vals[:, 2 * C:]], -1)  # (M, C, 2)
-            parts.append((ok, world.take(ok, 0), grad, r))
+            parts.append((ok, world.take(ok, 0), grad, r, noise))
         return _Samples(np.concatenate(costs), parts, n_inside / np.maximum(n_pts, 1),
                         measured if sigmas is None else sigmas, shape_cost, shape_parts)
 
-    def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, sigma: np.ndarray
+    def _pixel_weights(self, ps: PointSet, ok: np.ndarray, r: np.ndarray, noise: np.ndarray
                        ) -> np.ndarray:
         """Weights (M, C) of a point set's usable points ``ok`` with residuals ``r`` (M, C)
-        (the set's points' noise scales ``sigma`` (N, C)): their rim weight times the EM
-        support posterior over each channel's noise scale squared."""
-        return ps.weight[ok][:, None] * support_weights(r, sigma[ok],
+        and noise scales ``noise`` (M, C): their rim weight times the EM support posterior
+        over each channel's noise scale squared."""
+        return ps.weight[ok][:, None] * support_weights(r, noise,
                                                         self.settings.outlier_density)
 
-    def _pixel_rows(self, ps: PointSet, sigma: np.ndarray, part: tuple) -> tuple:
-        """A point set's usable points as rows, one per point and channel: their segments'
-        joints, world points (., 3), image gradients (., 2), residuals and weights."""
-        ok, world, grad, r = part
+    def _pixel_rows(self, ps: PointSet, part: tuple) -> tuple:
+        """A point set's usable points (``_Samples.parts``) as rows, one per point and
+        channel: their segments' joints, world points (., 3), image gradients (., 2),
+        residuals and weights."""
+        ok, world, grad, r, noise = part
         C = r.shape[1]
         return (np.repeat(ps.seg_joint[ok], C), np.repeat(world, C, axis=0),
-                grad.reshape(-1, 2), r.ravel(), self._pixel_weights(ps, ok, r, sigma).ravel())
+                grad.reshape(-1, 2), r.ravel(), self._pixel_weights(ps, ok, r, noise).ravel())
 
-    def _solver_rows(self, ps: PointSet, sigma: np.ndarray, part: tuple) -> tuple:
+    def _solver_rows(self, ps: PointSet, part: tuple) -> tuple:
         """``_pixel_rows`` as the normal equations take them: a grey pixel's one row, a
         colour pixel's channels as two rows that add the same (``solver.channel_rows``)."""
-        ok, world, grad, r = part
+        ok, world, grad, r, noise = part
         if r.shape[1] == 1:
-            return self._pixel_rows(ps, sigma, part)
+            return self._pixel_rows(ps, part)
         joints = ps.seg_joint[ok]
         return (np.concatenate([joints, joints]), np.concatenate([world, world]),
-                *channel_rows(grad, r, self._pixel_weights(ps, ok, r, sigma)))
+                *channel_rows(grad, r, self._pixel_weights(ps, ok, r, noise)))
 
     def _normal_equations(self, kin: Kinematics, sets: list[PointSet], smp: _Samples,
-                          sigmas: list[np.ndarray], level: int) -> NormalEquations:
+                          level: int) -> NormalEquations:
         """Rows of every point set at the sampled pose, weighted by the EM support posterior,
         and the silhouette's rows (each mismatched pixel's two coordinates); one block of
         rows per view."""
         pieces = [[] for _ in range(self.seq.n_views)]  # per view: (joints, X, grad, r, w)
-        for ps, sigma, part in zip(sets, sigmas, smp.parts):
+        for ps, part in zip(sets, smp.parts):
             if len(part[0]):
-                pieces[ps.view].append(self._solver_rows(ps, sigma, part))
+                pieces[ps.view].append(self._solver_rows(ps, part))
         s = self.settings
         for c, pull in enumerate(smp.shape_parts):
             if pull is None or not len(pull.mm.weight):
@@ -734,10 +755,11 @@ class FrameFit:
     def _residual(self, sets: list[PointSet], smp: _Samples, sigmas: list[np.ndarray]) -> float:
         """RMS brightness error of the pixels that follow the body (support-weighted), in
         image units: what the report calls a frame's residual (colour footage's chroma
-        channels left out, so that it reads the same with colour or without)."""
+        channels left out, so that it reads the same with colour or without), each pixel
+        weighed at its set's noise scale (``_sigmas``), a steep edge's as any other's."""
         num = den = 0.0
-        for ps, sigma, (ok, _, _, r) in zip(sets, sigmas, smp.parts):
-            w = self._pixel_weights(ps, ok, r, sigma)[:, 0]
+        for ps, sigma, (ok, _, _, r, _) in zip(sets, sigmas, smp.parts):
+            w = self._pixel_weights(ps, ok, r, sigma[ok])[:, 0]
             r = r[:, 0]
             num += float(np.sum(w * r * r))
             den += float(np.sum(w))
@@ -753,7 +775,7 @@ class FrameFit:
         top = 1 + self.settings.outlier_density
         axis = kin.world_points(self._limbs.axis_joint, self._limbs.axis_ref)
         per_view, own_views = [], []
-        for c, (ps, sigma, (ok, _, _, r)) in enumerate(zip(sets, smp.sigmas, smp.parts)):
+        for c, (ps, sigma, (ok, _, _, r, _)) in enumerate(zip(sets, smp.sigmas, smp.parts)):
             support = np.full(len(ps.value), np.nan)
             support[ok] = np.minimum(
                 top * support_posterior(r, sigma[ok], self.settings.outlier_density), 1.0)
@@ -830,8 +852,7 @@ class FrameFit:
         sets = [self.point_set(prev, kin_prev, c, prev_frame, 0, 1.0)
                 for c in range(self.seq.n_views)]
         smp = self.sample(est, kin, sets, levels, 0)
-        return [(ps.view, *self._pixel_rows(ps, sigma, part))
-                for ps, sigma, part in zip(sets, smp.sigmas, smp.parts)]
+        return [(ps.view, *self._pixel_rows(ps, part)) for ps, part in zip(sets, smp.parts)]
 
     def track_frame(self, prev: BodyPose, prev_frame: int, key: BodyPose, key_frame: int,
                     predicted: BodyPose, frame: int, doubted: Collection[str] = (),
@@ -883,7 +904,7 @@ class FrameFit:
                                    iterations=total_iters, converged=False, diverged=True,
                                    reason=left, seconds=time.perf_counter() - t0)
             T = self._unknowns(est)
-            ne = self._normal_equations(kin, sets, smp, sigmas, level).changed(T)
+            ne = self._normal_equations(kin, sets, smp, level).changed(T)
             prior = s.prior * np.diag(ne.H)
             lam = s.damping
             converged = False
@@ -910,7 +931,7 @@ class FrameFit:
                         converged = True
                         break
                     if it + 1 < self._level_iterations:
-                        ne = self._normal_equations(kin, sets, smp, sigmas, level).changed(T)
+                        ne = self._normal_equations(kin, sets, smp, level).changed(T)
                 else:
                     lam *= 4
                     if lam > 1e4:

@@ -248,11 +248,13 @@ class Level:
             self.stack, self.origin, self.size, self.whole = self.whole(), (0, 0), None, None
         return self
 
-    def values(self, pixels: np.ndarray) -> np.ndarray:
-        """The channels' values (N, C) at integer level pixels (N, 2) = (x, y) in the level."""
+    def values(self, pixels: np.ndarray, derivatives: bool = False) -> np.ndarray:
+        """The channels' values (N, C) at integer level pixels (N, 2) = (x, y) in the level;
+        with ``derivatives``, (N, 3 C): then their x and y derivatives per level pixel."""
         self.holding(pixels[:, 0], pixels[:, 1], 0)
         x0, y0 = self.origin
-        return self.stack[pixels[:, 1] - y0, pixels[:, 0] - x0, :self.channels]
+        upto = 3 * self.channels if derivatives else self.channels
+        return self.stack[pixels[:, 1] - y0, pixels[:, 0] - x0, :upto]
 
 
 def _blur_reach(sigma: float) -> int:

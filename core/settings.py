@@ -47,6 +47,17 @@ class TrackerSettings:
     outlier_density: float = _knob(0.1, "Support maps: how likely a pixel is not to follow "
                                    "its blob (background, occluders, highlights)")
     noise_floor: float = _knob(0.01, "Smallest brightness noise assumed (0 to 1)")
+    registration_noise: float = _knob(0.6, "How far a body pixel may lie from where the "
+                                      "blobs put it, in pixels of each pyramid level (the "
+                                      "blobs are not the body's shape; samples fall between "
+                                      "pixels): each pixel's brightness noise grows by its "
+                                      "gradient times this, so a steep edge, which a small "
+                                      "misplacement changes most, counts less than flat "
+                                      "texture; only on the previous frame's pixels (the "
+                                      "key frame's hold the track against drift) of segments "
+                                      "two or more views see (one view's edges are what "
+                                      "tells its limbs apart; 0: every pixel its set's "
+                                      "noise)")
     rim_width: float = _knob(0.3, "Blob outline band whose pixels count less, as a share of "
                              "the blob's radius")
     prediction_gain: float = _knob(1.0, "Constant-velocity prediction of the next frame "

@@ -120,6 +120,16 @@ def support_weights(r: np.ndarray, sigma: float | np.ndarray, outlier: float) ->
     return (post if np.ndim(r) == 1 else post[:, None]) / sigma**2
 
 
+def point_noise(sigma: np.ndarray, slope: np.ndarray, misplaced: float) -> np.ndarray:
+    """Points' noise scales, ``sigma``'s shape: their measured ``sigma`` and, in
+    quadrature, what a misplacement of ``misplaced`` pixels (standard deviation, each way)
+    makes of their brightness, whose squared gradient is ``slope`` (per pixel squared):
+    a point misplaced by d changes by grad . d to first order, so its variance gains
+    misplaced^2 |grad|^2 (Simoncelli, Adelson and Heeger, 1991). A steep edge's pixel,
+    which the blobs' shapes misplace as much as any, varies most."""
+    return np.sqrt(sigma**2 + misplaced**2 * slope)
+
+
 def robust_scale(r: np.ndarray, floor: float) -> float:
     """Noise scale of residuals from their median absolute deviation, at least ``floor``."""
     if len(r) == 0:

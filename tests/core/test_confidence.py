@@ -30,7 +30,7 @@ from core.raycast import BlobStack
 from core.settings import TrackerSettings
 from core.skeleton import BALL, FIXED, HINGE, Skeleton, human_template
 from core.tracker import Tracker, doubts_begun, frames_to_check, track
-from support.synthetic import render, side_view
+from support.synthetic import EXACT, render, side_view
 
 
 @pytest.fixture(scope="module")
@@ -392,7 +392,7 @@ def test_a_limb_gone_from_the_footage_is_flagged_and_the_rest_are_not(template):
     frames = [[render(sk, pose, c, noise=0.01, seed=c),
                render(without, pose, c, noise=0.01, seed=10 + c),
                render(without, pose, c, noise=0.01, seed=20 + c)] for c in range(3)]
-    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0)), pose,
+    res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(limb_search=0, **EXACT)), pose,
                 [0, 1, 2])
     assert res.frames[0].limbs == {}  # the given pose is not judged
     checks = res.frames[1].limbs

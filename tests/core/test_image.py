@@ -44,6 +44,22 @@ def test_pyramid_derivatives_of_a_ramp_are_its_slope_per_full_pixel():
                                    atol=2e-4)
 
 
+def test_a_levels_values_at_its_pixels_carry_its_slope_per_level_pixel():
+    H, W = 128, 160
+    ys, xs = np.mgrid[0:H, 0:W].astype(np.float32)
+    img = 0.2 + 0.003 * xs + 0.002 * ys
+    for lv in image.pyramid(img, 3):
+        px = np.array([[20, 15], [25, 22]])  # inside every level, away from its edges
+        at = lv.values(px, derivatives=True)
+        assert at.shape == (2, 3)
+        np.testing.assert_allclose(at[:, 0], lv.values(px)[:, 0])
+        full = px * lv.scale  # the level pixel's full-resolution place (its corner)
+        np.testing.assert_allclose(at[:, 0], image.sample(lv, full.astype(float))[0][:, 0],
+                                   atol=1e-5)
+        np.testing.assert_allclose(at[:, 1], 0.003 * lv.scale, rtol=0.02)
+        np.testing.assert_allclose(at[:, 2], 0.002 * lv.scale, rtol=0.02)
+
+
 def test_points_outside_are_flagged():
     lv = image.pyramid(np.zeros((20, 30), np.float32), 2)[1]
     _, inside = image.sample(lv, np.array([[-3.0, 5.0], [10.0, 10.0], [29.9, 19.0]]))

@@ -14,7 +14,7 @@ from core.bvh import read_bvh, write_bvh
 from core.job import JobError, load_job, parse_camera
 from core.lens import undistort_points
 from core.pose import BodyPose
-from support.synthetic import render
+from support.synthetic import EXACT, render
 
 ROOT = Path(__file__).resolve().parents[2]
 JOINTS = {"LeftHip": "ball", "RightHip": "ball",
@@ -54,7 +54,7 @@ def footage(tmp_path_factory, cmu_walk):
            "views": [{"images": "side/*.png", "camera": CAMERA},
                      {"images": "front/*.png", "camera": FRONT},
                      {"images": "oblique/*.png", "camera": OBLIQUE}],
-           "mode": "calibrated", "settings": {"levels": 2, "iterations": 20}}
+           "mode": "calibrated", "settings": {"levels": 2, "iterations": 20, **EXACT}}
     (folder / "job.json").write_text(json.dumps(job))
     views = ["side", "front", "oblique"]
     for v in views:  # placeholders, so that the job loads and gives its skeleton's blobs

@@ -18,9 +18,10 @@ from core.refine import (
     segment_twists,
     without_spin,
 )
+from core.settings import TrackerSettings
 from core.skeleton import human_template, planar_chain_template
 from core.tracker import Tracker
-from support.synthetic import render, side_pinhole, side_view
+from support.synthetic import EXACT, render, side_pinhole, side_view
 
 
 def test_the_rank_one_factorisation_recovers_a_hinge_and_a_ball_centre():
@@ -137,7 +138,7 @@ def test_twists_estimated_from_footage_match_the_true_skeleton(camera):
     axes within 3 degrees and their centres within a centimetre (measured through
     orthographic views: 0.3 and 2.6 degrees, under 1 mm)."""
     sk, poses, images = _human_walk(camera=camera)
-    tracker = Tracker(sk, images, CALIBRATED)
+    tracker = Tracker(sk, images, CALIBRATED, TrackerSettings(**EXACT))
     for name in ("LeftKnee", "RightElbow"):
         j = sk.index(name)
         W = segment_twists(tracker, poses, list(range(len(poses))), j)

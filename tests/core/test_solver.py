@@ -8,6 +8,7 @@ from core.solver import (
     NormalEquations,
     channel_rows,
     mixture_cost,
+    point_noise,
     solve,
     support_posterior,
     support_weights,
@@ -149,3 +150,21 @@ def test_two_rows_a_pixel_pose_its_channels_normal_equations():
     np.testing.assert_allclose(two.b, channels.b, rtol=1e-10, atol=1e-10)
     assert not g2[2].any() and not g2[M + 2].any() and r2[2] == r2[M + 2] == 0
     assert not g2[M + 1].any()  # the rank-one pixel's second row
+
+
+
+
+def test_a_pixels_noise_adds_what_a_misplacement_makes_of_its_gradient():
+    """Monte Carlo against the formula: ramps read at points misplaced by a Gaussian of
+    ``misplaced`` pixels each way, with the image's own noise on top, vary as
+    ``point_noise`` says; a flat pixel keeps its own noise."""
+    rng = np.random.default_rng(3)
+    sigma, misplaced, n = 0.02, 0.6, 200_000
+    grads = np.array([[0.0, 0.0], [0.08, -0.05], [0.01, 0.02]])
+    spread = [np.std((rng.normal(0.0, misplaced, (n, 2)) @ g) + rng.normal(0.0, sigma, n))
+              for g in grads]
+    noise = point_noise(np.full((3, 1), sigma), np.sum(grads**2, axis=1)[:, None], misplaced)
+    np.testing.assert_allclose(spread, noise[:, 0], rtol=0.01)
+    assert noise[0, 0] == sigma
+    assert noise[1, 0] > 2.5 * sigma  # a steep edge's pixel weighs under a sixth of a flat one's
+    np.testing.assert_array_equal(point_noise(noise, np.ones_like(noise), 0.0), noise)

@@ -27,7 +27,7 @@ from core.side_on import (
 from core.skeleton import HINGE, human_template
 from core.solver import DegenerateSystem
 from core.tracker import Tracker, held_joints, residual_jump, track
-from support.synthetic import render, render_hues, side_pinhole, side_view
+from support.synthetic import EXACT, render, render_hues, side_pinhole, side_view
 
 VIEWS = [side_view(yaw_deg=90), side_view(yaw_deg=0), side_view(yaw_deg=60)]
 
@@ -117,8 +117,8 @@ def test_footage_whose_exposure_changes_keeps_its_silhouette_and_says_so(body, m
     def tracked(gains):
         frames = [[np.clip(g * render(sk, p, c, noise=0.01, seed=c), 0, 1)
                    for g, p in zip(gains, poses)] for c in range(3)]
-        res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10)), pose,
-                    [0, 1, 2])
+        res = track(Tracker(sk, frames, CALIBRATED, TrackerSettings(iterations=10, **EXACT)),
+                    pose, [0, 1, 2])
         return res.notes, max(_limb_errors(sk, f.pose, p).max() for f, p in
                               zip(res.frames[1:], poses[1:]))
 
@@ -760,6 +760,57 @@ def test_a_joined_point_set_keeps_each_frames_noise_scale(body):
     assert apart[0][0] > 2 * apart[1][0]  # the noisy frame's scale is its own
 
 
+def test_a_steep_pixel_is_noisier_only_on_the_previous_frame_where_several_views_see_it(
+        body):
+    """The blobs' misfit to the body counts as noise (a pixel's template gradient times
+    ``registration_noise``, in quadrature) only on the previous frame's points of segments
+    that two or more views see: the key frame's points, the anchor against drift, a
+    segment one view alone sees, and the whole of one view's footage keep their set's
+    noise (in one view the edges are what tells one limb from another)."""
+    sk, pose = body
+    frames = [[render(sk, pose, c, noise=0.01, seed=k) for k in range(3)] for c in range(3)]
+    tracker = Tracker(sk, frames, CALIBRATED)
+    beta = tracker.settings.registration_noise
+    kin = Kinematics(sk, pose)
+    levels = [tracker.seq.pyramid(c, 2)[0] for c in range(3)]
+    sets = [tracker.point_set(pose, kin, c, 1, 0, 1.0) for c in range(3)]
+    arm = sk.index("RightElbow")  # the right forearm's points, seen in every view
+    assert all(np.any(ps.seg_joint == arm) for ps in sets)
+
+    def scales(chosen):
+        """Per set: its usable points' segments, whether they are the key frame's, their
+        noise scales, the set's own scales and the scales with the misfit's term."""
+        smp = tracker.sample(pose, kin, chosen, levels, 0)
+        return [(ps.seg_joint[ok], ps.key_points()[ok], noise, sigma[ok],
+                 np.sqrt(sigma[ok]**2 + beta**2 * ps.slope[ok]))
+                for ps, (ok, *_, noise), sigma in zip(chosen, smp.parts, smp.sigmas)]
+
+    def without_arm(ps):
+        keep = ps.seg_joint != arm
+        return PointSet(ps.view, *(getattr(ps, f)[keep] for f in
+                                   ("seg_joint", "blob", "ref", "value", "weight", "slope")))
+
+    for _, _, noise, sigma, misfit in scales(sets):  # every segment seen by several views
+        np.testing.assert_allclose(noise, misfit, rtol=1e-12)
+        assert np.mean(noise > 1.5 * sigma) > 0.05  # the edges count as noisier
+    (seg, _, noise, sigma, misfit), *others = scales([sets[0]] + [without_arm(ps)
+                                                                  for ps in sets[1:]])
+    on_arm = seg == arm
+    np.testing.assert_array_equal(noise[on_arm], sigma[on_arm])  # view 1 alone sees it
+    np.testing.assert_allclose(noise[~on_arm], misfit[~on_arm], rtol=1e-12)
+    for _, _, noise, _, misfit in others:
+        np.testing.assert_allclose(noise, misfit, rtol=1e-12)
+    (_, _, noise, sigma, _), = scales(sets[:1])  # one view's footage
+    np.testing.assert_array_equal(noise, sigma)
+
+    keys = [tracker.point_set(pose, kin, c, 0, 0, 1.0) for c in range(3)]
+    for _, key, noise, sigma, misfit in scales([PointSet.joined([ps, k])
+                                                for ps, k in zip(sets, keys)]):
+        assert key.any() and (~key).any()
+        np.testing.assert_array_equal(noise[key], sigma[key])  # the key frame's points
+        np.testing.assert_allclose(noise[~key], misfit[~key], rtol=1e-12)
+        assert np.mean(noise[~key] > 1.5 * sigma[~key]) > 0.05
+
 
 def _swung(sk, pose: BodyPose, name: str, degrees: float, axis: int) -> BodyPose:
     """``pose`` with the ball joint ``name`` swung ``degrees`` about its bone frame's
@@ -800,7 +851,7 @@ def test_a_lost_limb_the_backdrop_refutes_in_a_view_is_turned_back_without_brigh
     pose = _swung(sk, rest, joint, held, axis)
     lost = _swung(sk, pose, joint, off, axis)
     frames = [[render(sk, pose, c, noise=0.01, seed=i) for i in range(3)] for c in range(3)]
-    tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(key_weight=0.0))
+    tracker = Tracker(sk, frames, CALIBRATED, TrackerSettings(key_weight=0.0, **EXACT))
     res = tracker.track_frame(lost, 1, pose, 0, lost, 2)
     assert _limb_errors(sk, res.pose, pose).max() < 2.0
     assert joint in res.searched
