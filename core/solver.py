@@ -120,11 +120,13 @@ def support_weights(r: np.ndarray, sigma: float | np.ndarray, outlier: float) ->
     return (post if np.ndim(r) == 1 else post[:, None]) / sigma**2
 
 
-def point_noise(sigma: np.ndarray, slope: np.ndarray, misplaced: float) -> np.ndarray:
+def point_noise(sigma: np.ndarray, slope: np.ndarray, misplaced: float | np.ndarray
+                ) -> np.ndarray:
     """Points' noise scales, ``sigma``'s shape: their measured ``sigma`` and, in
-    quadrature, what a misplacement of ``misplaced`` pixels (standard deviation, each way)
-    makes of their brightness, whose squared gradient is ``slope`` (per pixel squared):
-    a point misplaced by d changes by grad . d to first order, so its variance gains
+    quadrature, what a misplacement of ``misplaced`` pixels (standard deviation, each way;
+    one for all points or one per point, broadcast against ``sigma``) makes of their
+    brightness, whose squared gradient is ``slope`` (per pixel squared): a point
+    misplaced by d changes by grad . d to first order, so its variance gains
     misplaced^2 |grad|^2 (Simoncelli, Adelson and Heeger, 1991). A steep edge's pixel,
     which the blobs' shapes misplace as much as any, varies most."""
     return np.sqrt(sigma**2 + misplaced**2 * slope)

@@ -152,8 +152,6 @@ def test_two_rows_a_pixel_pose_its_channels_normal_equations():
     assert not g2[M + 1].any()  # the rank-one pixel's second row
 
 
-
-
 def test_a_pixels_noise_adds_what_a_misplacement_makes_of_its_gradient():
     """Monte Carlo against the formula: ramps read at points misplaced by a Gaussian of
     ``misplaced`` pixels each way, with the image's own noise on top, vary as
